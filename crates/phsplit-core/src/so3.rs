@@ -1,0 +1,276 @@
+//! The rotation group SO(3) and unit quaternions.
+//!
+//! Convention (stated once, used everywhere): an attitude `Q ∈ SO(3)` maps body-frame vectors
+//! to spatial vectors, and the kinematics are right-multiplied, `Q' = Q hat(w)` with `w` the
+//! body angular velocity (paper eq. 39). `exp` and `log` are the group exponential and its
+//! principal inverse; `hat(w) u = w × u`.
+//!
+//! Euler angles are ZYX (roll `phi`, pitch `theta`, yaw `psi`), `Q = Rz(psi) Ry(theta) Rx(phi)`
+//! (paper eq. 21). Quaternions are `q = (q0, q1, q2, q3)`, scalar first, with the
+//! Euler–Rodrigues map `E(q) = I + 2 q0 hat(qv) + 2 hat(qv)^2` (paper Appendix A).
+
+use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3, Vector4};
+
+/// `hat(w)`: the skew matrix with `hat(w) u = w × u`.
+#[inline]
+pub fn hat(w: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0)
+}
+
+/// `vee(S)`: inverse of [`hat`] on the skew part, `vee(S) = ((S32 − S23), (S13 − S31), (S21 − S12)) / 2`.
+#[inline]
+pub fn vee(s: &Matrix3<f64>) -> Vector3<f64> {
+    Vector3::new(
+        0.5 * (s[(2, 1)] - s[(1, 2)]),
+        0.5 * (s[(0, 2)] - s[(2, 0)]),
+        0.5 * (s[(1, 0)] - s[(0, 1)]),
+    )
+}
+
+/// The SO(3) exponential `exp(hat(w))` by the Rodrigues formula,
+/// `I + sin|w|/|w| hat(w) + (1 − cos|w|)/|w|^2 hat(w)^2`.
+///
+/// The coefficients are evaluated in cancellation-free form (`1 − cos θ = 2 sin²(θ/2)`), and by
+/// their Taylor series when `|w| < 1e-4`, so the result is accurate to round-off for tiny angles.
+pub fn exp(w: &Vector3<f64>) -> Matrix3<f64> {
+    let (a, b) = rodrigues_coefficients(w.norm());
+    let k = hat(w);
+    Matrix3::identity() + k * a + (k * k) * b
+}
+
+/// `(sin θ/θ, (1 − cos θ)/θ²)` with small-angle series.
+#[inline]
+fn rodrigues_coefficients(theta: f64) -> (f64, f64) {
+    if theta < 1e-4 {
+        let t2 = theta * theta;
+        // Taylor series; next terms are O(θ^6) ≈ 1e-24, below round-off.
+        (
+            1.0 - t2 / 6.0 + t2 * t2 / 120.0,
+            0.5 - t2 / 24.0 + t2 * t2 / 720.0,
+        )
+    } else {
+        let s = (0.5 * theta).sin() / theta;
+        (theta.sin() / theta, 2.0 * s * s)
+    }
+}
+
+/// The principal SO(3) logarithm: `w` with `exp(w) = R` and `|w| ≤ π`.
+///
+/// The angle is `atan2(|vee(R − Rᵀ)|, (tr R − 1)/2)`, accurate at every angle (an `acos` of the
+/// trace loses half the digits near 0 and π). Near π, where `R − Rᵀ` vanishes, the axis is read
+/// from the symmetric part `(R + Rᵀ)/2 − cos θ I = (1 − cos θ) n nᵀ` whenever `θ > π/2`.
+pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
+    let v = vee(r); // = sin θ n
+    let s = v.norm();
+    let c = 0.5 * (r.trace() - 1.0);
+    let theta = s.atan2(c);
+    if theta < 1e-4 {
+        // θ/sin θ = 1 + θ²/6 + 7θ⁴/360
+        let t2 = theta * theta;
+        return v * (1.0 + t2 / 6.0 + 7.0 * t2 * t2 / 360.0);
+    }
+    if c >= 0.0 {
+        return v * (theta / s);
+    }
+    // θ > π/2: |v| = sin θ shrinks towards π, so read the axis from the symmetric part,
+    // n nᵀ = (sym(R) − c I) / (1 − c); take the largest diagonal for the axis, then fix
+    // its sign with the (small but reliable) skew part.
+    let b = ((r + r.transpose()) * 0.5 - Matrix3::identity() * c) / (1.0 - c);
+    let i = (0..3)
+        .max_by(|&i, &j| b[(i, i)].total_cmp(&b[(j, j)]))
+        .unwrap_or(0);
+    let mut n: Vector3<f64> = b.column(i).into();
+    n /= n.norm();
+    if n.dot(&v) < 0.0 {
+        n = -n;
+    }
+    n * theta
+}
+
+/// Elementary rotations about x, y, z.
+fn rx(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+}
+fn ry(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+}
+fn rz(a: f64) -> Matrix3<f64> {
+    let (s, c) = a.sin_cos();
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+
+/// `Q = Rz(psi) Ry(theta) Rx(phi)` from ZYX Euler angles `(phi, theta, psi)` (paper eq. 21).
+pub fn from_euler_zyx(e: &Vector3<f64>) -> Matrix3<f64> {
+    rz(e.z) * ry(e.y) * rx(e.x)
+}
+
+/// ZYX Euler angles `(phi, theta, psi)` of `Q` (paper eq. 21), with `theta ∈ [−π/2, π/2]`,
+/// `phi, psi ∈ (−π, π]`.
+///
+/// Read directly from the entries of `Q`, so a matrix that is only nearly orthogonal (an explicit
+/// Runge–Kutta attitude) still gets angles. The pitch uses `atan2` on `−Q31` against the norm of
+/// the first column's other entries, which stays accurate near ±π/2 where `asin` would not.
+pub fn euler_zyx(q: &Matrix3<f64>) -> Vector3<f64> {
+    let phi = q[(2, 1)].atan2(q[(2, 2)]);
+    let theta = (-q[(2, 0)]).atan2(q[(0, 0)].hypot(q[(1, 0)]));
+    let psi = q[(1, 0)].atan2(q[(0, 0)]);
+    Vector3::new(phi, theta, psi)
+}
+
+/// `Pi_e(theta)`: maps ZYX Euler-angle rates to the spatial angular velocity,
+/// `Q w = Pi_e(theta) theta'` (paper, §3 and MODEL.md §2).
+pub fn pi_e(e: &Vector3<f64>) -> Matrix3<f64> {
+    let (st, ct) = e.y.sin_cos();
+    let (sp, cp) = e.z.sin_cos();
+    Matrix3::new(ct * cp, -sp, 0.0, ct * sp, cp, 0.0, -st, 0.0, 1.0)
+}
+
+/// `Pi_e(theta)^{-1}` in closed form (singular at `cos theta = 0`, the gimbal lock of ZYX angles).
+pub fn pi_e_inv(e: &Vector3<f64>) -> Matrix3<f64> {
+    let (st, ct) = e.y.sin_cos();
+    let (sp, cp) = e.z.sin_cos();
+    Matrix3::new(
+        cp / ct,
+        sp / ct,
+        0.0,
+        -sp,
+        cp,
+        0.0,
+        cp * st / ct,
+        sp * st / ct,
+        1.0,
+    )
+}
+
+/// Euler–Rodrigues map `E(q) = I + 2 q0 hat(qv) + 2 hat(qv)^2` for a unit quaternion
+/// `q = (q0, qv)` (paper Appendix A).
+pub fn rodrigues(q: &Vector4<f64>) -> Matrix3<f64> {
+    let qv = Vector3::new(q[1], q[2], q[3]);
+    let k = hat(&qv);
+    Matrix3::identity() + k * (2.0 * q[0]) + (k * k) * 2.0
+}
+
+/// The unit quaternion `(q0, q1, q2, q3)` (scalar first) of a rotation matrix, with the sign
+/// chosen so that `q0 ≥ 0`. A matrix that is only nearly orthogonal is first projected to the
+/// nearest rotation.
+pub fn quaternion(q: &Matrix3<f64>) -> Vector4<f64> {
+    let rot = Rotation3::from_matrix_eps(q, 1e-15, 100, Rotation3::identity());
+    let uq = UnitQuaternion::from_rotation_matrix(&rot);
+    let c = uq.quaternion().coords; // nalgebra stores (i, j, k, w)
+    let mut out = Vector4::new(c[3], c[0], c[1], c[2]);
+    if out[0] < 0.0 {
+        out = -out;
+    }
+    out
+}
+
+/// Quaternion product `a ∘ b`, scalar first.
+pub fn quat_mul(a: &Vector4<f64>, b: &Vector4<f64>) -> Vector4<f64> {
+    let qa = Quaternion::new(a[0], a[1], a[2], a[3]);
+    let qb = Quaternion::new(b[0], b[1], b[2], b[3]);
+    let p = qa * qb;
+    Vector4::new(p.w, p.i, p.j, p.k)
+}
+
+/// Re-orthonormalise a nearly orthogonal matrix to the nearest rotation (polar factor).
+pub fn orthonormalize(q: &Matrix3<f64>) -> Matrix3<f64> {
+    Rotation3::from_matrix_eps(q, 1e-15, 100, Rotation3::identity()).into_inner()
+}
+
+/// `‖QᵀQ − I‖_F`, the distance of `Q` from the orthogonal group.
+pub fn orthogonality_defect(q: &Matrix3<f64>) -> f64 {
+    (q.transpose() * q - Matrix3::identity()).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn v3() -> impl Strategy<Value = Vector3<f64>> {
+        (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0).prop_map(|(a, b, c)| Vector3::new(a, b, c))
+    }
+
+    #[test]
+    fn hat_is_cross_product_and_vee_inverts_it() {
+        let w = Vector3::new(0.3, -1.2, 2.5);
+        let u = Vector3::new(-0.7, 0.1, 0.4);
+        assert!((hat(&w) * u - w.cross(&u)).norm() < 1e-15);
+        assert_eq!(vee(&hat(&w)), w);
+    }
+
+    #[test]
+    fn exp_matches_nalgebra_axis_angle() {
+        // nalgebra builds the rotation through a quaternion: an independent path.
+        for w in [
+            Vector3::new(0.3, -1.2, 2.5),
+            Vector3::new(1e-9, 2e-9, -1e-9),
+            Vector3::new(0.0, 0.0, 3.1),
+        ] {
+            let r = Rotation3::from_scaled_axis(w).into_inner();
+            assert!((exp(&w) - r).norm() < 4e-16 * 9.0, "{w}");
+        }
+    }
+
+    #[test]
+    fn log_small_and_near_pi() {
+        let w = Vector3::new(3e-9, -1e-9, 2e-9);
+        assert!((log(&exp(&w)) - w).norm() < 1e-24);
+        let n = Vector3::new(1.0, 2.0, -2.0) / 3.0;
+        for th in [
+            std::f64::consts::PI - 1e-9,
+            std::f64::consts::PI - 2e-3,
+            3.0,
+        ] {
+            let w = n * th;
+            let back = log(&exp(&w));
+            assert!((back - w).norm() < 1e-7, "{th}: {back} vs {w}");
+            assert!((exp(&back) - exp(&w)).norm() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn euler_roundtrip_and_pi_e() {
+        let e = Vector3::new(0.05, -0.02, 0.10);
+        let q = from_euler_zyx(&e);
+        assert!((euler_zyx(&q) - e).norm() < 1e-15);
+        // Pi_e maps Euler rates to the spatial angular velocity: check by finite differences of Q.
+        let ed = Vector3::new(0.3, -0.2, 0.7);
+        let dt = 1e-6;
+        let qd = (from_euler_zyx(&(e + ed * dt)) - from_euler_zyx(&(e - ed * dt))) / (2.0 * dt);
+        let omega_spatial = vee(&(qd * q.transpose()));
+        assert!((pi_e(&e) * ed - omega_spatial).norm() < 1e-9);
+        assert!((pi_e(&e) * pi_e_inv(&e) - Matrix3::identity()).norm() < 1e-15);
+    }
+
+    proptest! {
+        #[test]
+        fn exp_is_orthogonal_and_log_inverts(w in v3().prop_map(|v| v * 3.0)) {
+            let r = exp(&w);
+            prop_assert!(orthogonality_defect(&r) < 1e-14);
+            prop_assert!((r.determinant() - 1.0).abs() < 1e-14);
+            prop_assert!((exp(&log(&r)) - r).norm() < 1e-14);
+            if w.norm() < 3.0 {
+                prop_assert!((log(&r) - w).norm() < 1e-12);
+            }
+        }
+
+        #[test]
+        fn quaternion_and_matrix_paths_agree(w in v3().prop_map(|v| v * 3.0), u in v3().prop_map(|v| v * 3.0)) {
+            let (ra, rb) = (exp(&w), exp(&u));
+            let (qa, qb) = (quaternion(&ra), quaternion(&rb));
+            prop_assert!((qa.norm() - 1.0).abs() < 1e-15 * 4.0);
+            prop_assert!((rodrigues(&qa) - ra).norm() < 1e-14);
+            // The product of quaternions represents the product of matrices.
+            prop_assert!((rodrigues(&quat_mul(&qa, &qb)) - ra * rb).norm() < 1e-14);
+        }
+
+        #[test]
+        fn euler_angles_roundtrip(phi in -3.0f64..3.0, th in -1.5f64..1.5, psi in -3.0f64..3.0) {
+            let e = Vector3::new(phi, th, psi);
+            prop_assert!((euler_zyx(&from_euler_zyx(&e)) - e).norm() < 1e-13);
+        }
+    }
+}
