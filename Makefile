@@ -1,0 +1,41 @@
+# The two commands of the README: `make run` and `make test`. Each sets up what it needs on a
+# fresh machine (a virtual environment in .venv, the Python dependencies, the Rust build) and
+# is quick the second time (stamps; cargo and maturin rebuild only what changed).
+
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+OUT    ?= out
+RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
+
+.PHONY: run test test-rust test-python build elliptic-refs clean
+
+run: $(VENV)/.built
+	$(BIN)/phsplit simulate --out $(OUT)
+
+test: test-rust test-python
+
+test-rust:
+	cargo test -p phsplit-core --release
+
+test-python: $(VENV)/.built
+	$(BIN)/python -m pytest -q python/tests
+
+build: $(VENV)/.built
+
+$(VENV)/.deps: python/requirements-dev.txt
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -r python/requirements-dev.txt
+	touch $@
+
+$(VENV)/.built: $(VENV)/.deps $(RUST_SRC) python/pyproject.toml
+	cd python && VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH $(abspath $(BIN))/maturin develop --release --quiet
+	touch $@
+
+# Regenerate the mpmath reference table of the elliptic functions (checked in).
+elliptic-refs: $(VENV)/.deps
+	$(BIN)/python scripts/gen_elliptic_refs.py
+
+clean:
+	rm -rf $(VENV) target $(OUT)

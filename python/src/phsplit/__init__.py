@@ -1,0 +1,42 @@
+"""phsplit: passivity-preserving splitting methods for marine vessel dynamics.
+
+Implements Celledoni, Høiseth & Ramzina, *Passivity-preserving splitting methods for rigid body
+systems*, Multibody System Dynamics 44 (2018) 251–275, on a Rust core.
+
+>>> import phsplit
+>>> sol = phsplit.simulate(phsplit.Vessel.paper(), t_span=(0.0, 10.0), h=0.5, method="sp2")
+>>> sol.x.shape
+(21, 3)
+"""
+from __future__ import annotations
+
+from ._core import (
+    METHODS,
+    IntegrationError,
+    InvalidInputError,
+    PhsplitError,
+    ScenarioParseError,
+    __version__,
+)
+from ._core import method_info as _method_info
+from .simulate import Ledger, Solution, Vessel, simulate
+
+
+def method_info(name: str) -> dict:
+    """Order, stages, citation and passivity guarantee of a method (see ``METHODS``)."""
+    return dict(_method_info(name))
+
+
+__all__ = [
+    "METHODS",
+    "IntegrationError",
+    "InvalidInputError",
+    "Ledger",
+    "PhsplitError",
+    "ScenarioParseError",
+    "Solution",
+    "Vessel",
+    "__version__",
+    "method_info",
+    "simulate",
+]
