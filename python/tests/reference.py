@@ -1,0 +1,99 @@
+"""An independent reference for the vessel: eq. (39) of the paper written again in numpy, from
+MODEL.md §2, and integrated by scipy's DOP853 at tight tolerance. Nothing here calls phsplit's
+integrators or its vector field; only the initial state and the parameters are shared."""
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+
+def hat(w):
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+def euler_zyx(Q):
+    return np.array([np.arctan2(Q[2, 1], Q[2, 2]),
+                     np.arctan2(-Q[2, 0], np.hypot(Q[0, 0], Q[1, 0])),
+                     np.arctan2(Q[1, 0], Q[0, 0])])
+
+
+def pi_e(th):
+    _, t, p = th
+    return np.array([[np.cos(t) * np.cos(p), -np.sin(p), 0.0],
+                     [np.cos(t) * np.sin(p), np.cos(p), 0.0],
+                     [-np.sin(t), 0.0, 1.0]])
+
+
+class Field:
+    """y' of eq. (39) with the PID control (29)–(33); y = (p, m, Q col-major, mu, x, phi_th, phi_x)."""
+
+    def __init__(self, params: dict, control_on: bool):
+        h, c = params["vessel"], params["control"]
+        self.mv = h["mass"]
+        self.T = np.array(h["inertia"])
+        self.Dt = np.array(h["damping_translational"])
+        self.Dr = np.array(h["damping_rotational"])
+        self.lam = np.array([0.0, 0.0, h["gravity"] * h["water_density"] * h["waterplane_area"]])
+        w = self.mv * h["gravity"]
+        self.G = np.array([w * h["gm_longitudinal"], w * h["gm_transverse"], 0.0])
+        self.Gp = np.where(self.G > 0, 1.0 / np.where(self.G > 0, self.G, 1.0), 0.0)
+        k = 1.0 if control_on else 0.0
+        self.K = {n: k * np.diag(c[n]) for n in ("kp_translational", "kd_translational", "ki_translational",
+                                                    "kp_rotational", "kd_rotational", "ki_rotational")}
+        self.xr = np.array(c["position_reference"])
+        self.thr = np.array(c["euler_reference"])
+        self.on = control_on
+
+    def __call__(self, t, y):
+        p, m, Q = y[0:3], y[3:6], y[6:15].reshape(3, 3, order="F")
+        mu, x, phth, phx = y[15:18], y[18:21], y[21:24], y[24:27]
+        v, w = p / self.mv, m / self.T
+        q3 = Q.T @ np.array([0.0, 0.0, 1.0])
+        th = euler_zyx(Q)
+        W = np.linalg.solve(pi_e(th), Q)
+        K = self.K
+        tau_t = -Q.T @ (K["kp_translational"] @ (x - self.xr) + K["kd_translational"] @ Q @ v
+                        + K["ki_translational"] @ phx)
+        tau_r = -W.T @ (K["kp_rotational"] @ (th - self.thr) + K["kd_rotational"] @ W @ w
+                        + K["ki_rotational"] @ phth)
+        dy = np.empty(27)
+        dy[0:3] = -np.cross(w, p) - (self.Dt * v + Q.T @ (self.lam * x) - tau_t)
+        dy[3:6] = -np.cross(w, m) - (self.Dr * w + np.cross(mu, q3) - tau_r)
+        dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
+        dy[15:18] = -self.G * np.cross(w, q3)
+        dy[18:21] = Q @ v
+        dy[21:24] = (th - self.thr) if self.on else 0.0
+        dy[24:27] = (x - self.xr) if self.on else 0.0
+        return dy
+
+    def energy(self, y):
+        p, m, mu, x = y[0:3], y[3:6], y[15:18], y[18:21]
+        return 0.5 * m @ (m / self.T) + 0.5 * p @ p / self.mv + 0.5 * mu @ (self.Gp * mu) + 0.5 * self.lam[2] * x[2] ** 2
+
+
+def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | None, t_eval=None,
+          rtol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
+    """Reference solution on [0, t_end]: DOP853 with rtol 1e-13, split at the controller switch.
+    Returns (t, y) with y of shape (len(t), 27)."""
+    segments = []
+    cs = control_start if control_start is not None else np.inf
+    if cs > 0:
+        segments.append((0.0, min(cs, t_end), False))
+    if cs < t_end:
+        segments.append((max(cs, 0.0), t_end, True))
+    t_eval = np.asarray(t_eval) if t_eval is not None else np.array([t_end])
+    ts, ys = [], []
+    y = np.array(y0, dtype=float)
+    atol = np.maximum(np.abs(y0), 1.0) * rtol * 1e-3
+    for a, b, on in segments:
+        f = Field(params, on)
+        last = b == t_end
+        sel = t_eval[(t_eval >= a) & ((t_eval < b) | (last & (t_eval <= b)))]
+        sol = solve_ivp(f, (a, b), y, method="DOP853", rtol=rtol, atol=atol,
+                        t_eval=np.unique(np.concatenate([sel, [b]])), dense_output=False)
+        assert sol.success, sol.message
+        keep = np.isin(sol.t, sel)
+        ts.append(sol.t[keep])
+        ys.append(sol.y.T[keep])
+        y = sol.y[:, -1]
+    return np.concatenate(ts), np.concatenate(ys)
