@@ -1,0 +1,110 @@
+"""The CLI's main job, scenario files, and the composition options."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import phsplit
+from phsplit.cli import main
+
+
+def test_default_simulate_writes_netcdf_and_png(tmp_path, capsys):
+    assert main(["simulate", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    nc, png = tmp_path / "fig2.nc", tmp_path / "fig2.png"
+    assert nc.stat().st_size > 10_000 and png.stat().st_size > 10_000
+    assert str(nc) in out and str(png) in out
+    with xr.open_dataset(nc) as ds:
+        assert ds.sizes["time"] == 401
+        assert ds.attrs["method"] == "sp4"
+        assert abs(float(ds["position"][-1, 0]) - 780.0) < 1.5
+    assert not list(tmp_path.glob(".tmp-*")), "temporary files left behind"
+
+
+def test_scenario_file_runs_instead(tmp_path):
+    sc = tmp_path / "short.toml"
+    sc.write_text('[simulation]\nt_span = [0.0, 20.0]\nh = 0.25\nmethod = "sp2"\ncontrol_start = 5.0\n')
+    assert main(["simulate", str(sc), "--out", str(tmp_path), "--no-plot"]) == 0
+    with xr.open_dataset(tmp_path / "short.nc") as ds:
+        assert ds.sizes["time"] == 81 and ds.attrs["method"] == "sp2"
+
+
+@pytest.mark.parametrize(
+    "text,needle",
+    [
+        ('[simulation]\nmethdo = "sp2"\n', "did you mean 'method'"),
+        ('[simulation]\nh = "fast"\n', "simulation.h"),
+        ('[simulation\nh = 1\n', "TOML syntax error"),
+        ('[simulation]\nmethod = "rk45"\n', "valid methods"),
+    ],
+)
+def test_bad_scenarios_exit_2_with_one_clear_line(tmp_path, text, needle):
+    sc = tmp_path / "bad.toml"
+    sc.write_text(text)
+    r = subprocess.run([sys.executable, "-m", "phsplit", "simulate", str(sc), "--out", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 2, r.stderr
+    assert needle in r.stderr and "Traceback" not in r.stderr
+    assert not list(tmp_path.glob("*.nc"))
+
+
+def test_help_has_examples():
+    r = subprocess.run([sys.executable, "-m", "phsplit", "simulate", "--help"], capture_output=True, text=True)
+    assert r.returncode == 0 and "examples:" in r.stdout
+
+
+@pytest.mark.parametrize("outer", ["dissipative", "conservative"])
+def test_either_flow_may_be_outermost(outer):
+    """Both arrangements converge at order 2 (SP2, self-convergence against h/8) and close the
+    ledger; they differ from each other at O(h^2)."""
+    v = phsplit.Vessel.paper()
+    ends = [phsplit.simulate(v, (0.0, 4.0), h, "sp2", control_start=0.0, outer=outer).m[-1]
+            for h in (0.5, 0.25, 0.0625)]
+    e1, e2 = np.linalg.norm(ends[0] - ends[2]), np.linalg.norm(ends[1] - ends[2])
+    assert 3.0 < e1 / e2 < 5.5  # ratio of (1 - 1/64)/(1/4 - 1/64) * ... ≈ 4.3 for order 2
+    s = phsplit.simulate(v, (0.0, 20.0), 0.5, "sp2", control_start=0.0, outer=outer)
+    assert s.ledger.relative_residual().max() < 1e-10
+
+
+def test_save_every_and_failures_are_reported():
+    v = phsplit.Vessel.paper()
+    s = phsplit.simulate(v, (0.0, 10.0), 0.5, "sp4", save_every=4)
+    assert list(s.t) == [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]
+    full = phsplit.simulate(v, (0.0, 10.0), 0.5, "sp4")
+    np.testing.assert_allclose(s.x[-1], full.x[-1], rtol=1e-12)
+    # RK4 far beyond its stability limit diverges: the run stops with a status, no NaN arrays.
+    r = phsplit.simulate(v, (0.0, 2000.0), 4.0, "rk4", control_start=0.0, ledger=False)
+    assert r.status == "failed" and "non-finite" in r.failure
+    assert np.all(np.isfinite(r.x)) and np.all(np.isfinite(r.last_good_state))
+    # ... while SP2 at the same step stays bounded (energy never above its start plus supply).
+    s2 = phsplit.simulate(v, (0.0, 2000.0), 4.0, "sp2", control_start=0.0)
+    assert s2.status == "completed" and np.all(np.isfinite(s2.energy))
+
+
+@pytest.mark.parametrize(
+    "kwargs,needle",
+    [
+        ({"h": -1.0}, "h must be"),
+        ({"h": float("nan")}, "h must be"),
+        ({"t_span": (5.0, 1.0)}, "t1 > t0"),
+        ({"outer": "middle"}, "outer must be"),
+        ({"save_every": 0}, "save_every"),
+        ({"initial": {"euler": [0.0, 0.0]}}, "3 components"),
+        ({"initial": {"speed": [0.0, 0.0, 0.0]}}, "allowed"),
+    ],
+)
+def test_bad_arguments_raise_clear_errors(kwargs, needle):
+    with pytest.raises(phsplit.InvalidInputError, match=needle):
+        phsplit.simulate(phsplit.Vessel.paper(), **kwargs)
+
+
+def test_bad_vessel_parameters_name_the_field():
+    text = phsplit.Vessel.paper_toml().replace("mass = 6.3622085e6", "mass = -1.0")
+    with pytest.raises(phsplit.InvalidInputError, match=r"vessel\.mass must be > 0"):
+        phsplit.Vessel.from_toml_str(text)
+    with pytest.raises(phsplit.ScenarioParseError, match="unknown field"):
+        phsplit.Vessel.from_toml_str(phsplit.Vessel.paper_toml().replace("gravity", "gravitty"))
