@@ -185,6 +185,15 @@ impl<'m, M: Model> Recorder<'m, M> {
             acc: Work::default(),
         }
     }
+    /// End the run: the state became non-finite during step `step`, which started at `t`.
+    fn fail(mut self, step: usize, t: f64) -> Trajectory<M::State> {
+        self.traj.status = Status::Failed {
+            step,
+            t,
+            reason: "the state became non-finite".into(),
+        };
+        self.traj
+    }
     fn save(&mut self, t: f64, y: M::State) {
         self.traj.t.push(t);
         self.traj.states.push(y);
@@ -247,12 +256,7 @@ pub fn run_splitting<M: SplitModel>(
             rec.acc += model.flow(flow, len, t, method.order, opts.ledger, &mut y);
         }
         if !model.is_finite(&y) {
-            rec.traj.status = Status::Failed {
-                step: n,
-                t,
-                reason: "the state became non-finite".into(),
-            };
-            return Ok(rec.traj);
+            return Ok(rec.fail(n, t));
         }
         rec.traj.steps = n + 1;
         if pending.is_none() {
@@ -303,12 +307,7 @@ pub fn run_runge_kutta<const N: usize, M: FieldModel<N>>(
         rec.acc += work;
         let state = model.from_vector(&y);
         if !model.is_finite(&state) {
-            rec.traj.status = Status::Failed {
-                step: n,
-                t,
-                reason: "the state became non-finite".into(),
-            };
-            return Ok(rec.traj);
+            return Ok(rec.fail(n, t));
         }
         rec.traj.steps = n + 1;
         rec.traj.last_good = state;
