@@ -8,7 +8,7 @@ BIN    := $(VENV)/bin
 OUT    ?= out
 RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
 
-.PHONY: run test test-rust test-python build elliptic-refs clean
+.PHONY: run test test-rust test-python build reproduce elliptic-refs clean
 
 run: $(VENV)/.built
 	$(BIN)/phsplit simulate --out $(OUT)
@@ -32,6 +32,10 @@ $(VENV)/.deps: python/requirements-dev.txt
 $(VENV)/.built: $(VENV)/.deps $(RUST_SRC) python/pyproject.toml
 	cd python && VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH $(abspath $(BIN))/maturin develop --release --quiet
 	touch $@
+
+# The paper's §4: Figs. 2-4, the stability sweep and a report, in reproduction/.
+reproduce: $(VENV)/.built
+	$(BIN)/phsplit reproduce --out reproduction
 
 # Regenerate the mpmath reference table of the elliptic functions (checked in).
 elliptic-refs: $(VENV)/.deps

@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import phsplit
-import reference as ref
+from phsplit import reference as ref
 
 VESSEL = phsplit.Vessel.paper()
 PARAMS = VESSEL.to_dict()

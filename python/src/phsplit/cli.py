@@ -12,6 +12,8 @@ EXAMPLES = """examples:
   phsplit simulate scenario.toml --out runs/
   phsplit simulate --method sp2 --h 0.25 --t-end 400
   phsplit methods                          # methods with order, stages and passivity guarantee
+  phsplit reproduce --out paper/           # the paper's Figs. 2-4, stability sweep and report
+  phsplit reproduce --quick                # the same in a few seconds, with coarser references
 """
 
 
@@ -37,6 +39,17 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--t-end", type=float, help="override the end time, s")
     s.add_argument("--no-plot", action="store_true", help="skip the PNG")
     sub.add_parser("methods", help="list the integration methods")
+    r = sub.add_parser(
+        "reproduce",
+        help="regenerate the paper's Figs. 2, 3, 4 and the stability sweep, with a report",
+        description="Run the experiments of the paper's §4 and write PNG/PDF figures, NetCDF data "
+        "and report.md / report.html (a table of the paper's claims with what was measured).",
+        epilog=EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    r.add_argument("--out", default="reproduction", help="output folder (default: ./reproduction)")
+    r.add_argument("--quick", action="store_true", help="coarser references and fewer steps (a few seconds)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
 
 
@@ -47,7 +60,7 @@ class UsageError(Exception):
 def _simulate(args) -> int:
     import phsplit
     from . import scenario as scn
-    from .plotting import plot_positions, reference_of
+    from .plotting import plot_positions, publish, reference_of
 
     sc = scn.load(args.scenario) if args.scenario else scn.Scenario.paper_fig2()
     if args.method:
@@ -76,7 +89,7 @@ def _simulate(args) -> int:
     os.close(fd)
     try:
         ds.to_netcdf(tmp)
-        os.replace(tmp, nc)
+        publish(tmp, nc)
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
@@ -99,6 +112,28 @@ def _simulate(args) -> int:
     return 0
 
 
+def _reproduce(args) -> int:
+    from .reproduce import reproduce, summary_table
+
+    out = args.out
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise UsageError(f"output folder {out!r} is not writable")
+    t0 = time.perf_counter()
+    try:
+        res = reproduce(out, quick=args.quick, progress=not args.no_progress and sys.stderr.isatty())
+    except PermissionError as e:
+        raise UsageError(str(e)) from None
+    print(summary_table(res))
+    held = sum(c.holds for c in res.claims)
+    print(f"\n{held} of {len(res.claims)} claims hold; {time.perf_counter() - t0:.1f} s")
+    print(f"wrote figures, data and report to {os.path.abspath(out)} (report.md, report.html)")
+    return 0 if held == len(res.claims) else 1
+
+
 def _methods() -> int:
     import phsplit
 
@@ -109,7 +144,15 @@ def _methods() -> int:
     return 0
 
 
+def _sigterm(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
+    import signal
+
+    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
+        signal.signal(signal.SIGTERM, _sigterm)  # clean up staging files as on Ctrl-C
     parser = _parser()
     args = parser.parse_args(argv)
     if args.command is None:
@@ -120,6 +163,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.command == "simulate":
             return _simulate(args)
+        if args.command == "reproduce":
+            return _reproduce(args)
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

@@ -1,6 +1,9 @@
 """An independent reference for the vessel: eq. (39) of the paper written again in numpy, from
-MODEL.md §2, and integrated by scipy's DOP853 at tight tolerance. Nothing here calls phsplit's
-integrators or its vector field; only the initial state and the parameters are shared."""
+MODEL.md §2, and integrated by scipy's DOP853 at tight tolerance.
+
+Nothing here calls phsplit's integrators or its Rust vector field; only the initial state and
+the parameters are shared. The tests and ``phsplit reproduce`` use it to check the splitting
+methods against a computation that shares no code with them."""
 from __future__ import annotations
 
 import numpy as np
@@ -65,6 +68,16 @@ class Field:
         dy[21:24] = (th - self.thr) if self.on else 0.0
         dy[24:27] = (x - self.xr) if self.on else 0.0
         return dy
+
+    def control_torque(self, y):
+        """The rotational control input tau_r (body frame, N m) at state y (zero when off)."""
+        m, Q, phth = y[3:6], y[6:15].reshape(3, 3, order="F"), y[21:24]
+        w = m / self.T
+        th = euler_zyx(Q)
+        W = np.linalg.solve(pi_e(th), Q)
+        K = self.K
+        return -W.T @ (K["kp_rotational"] @ (th - self.thr) + K["kd_rotational"] @ W @ w
+                       + K["ki_rotational"] @ phth)
 
     def energy(self, y):
         p, m, mu, x = y[0:3], y[3:6], y[15:18], y[18:21]
