@@ -84,7 +84,13 @@ def test_unknown_option():
 def test_interrupted_run_leaves_nothing_behind(tmp_path):
     p = subprocess.Popen([sys.executable, "-m", "phsplit", "reproduce", "--quick", "--out", str(tmp_path)],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(2.5)
+    # Wait until the run is under way (its staging folder exists), then stop it.
+    deadline = time.monotonic() + 120
+    while not any(n.startswith(".phsplit-reproduce-") for n in os.listdir(tmp_path)):
+        assert p.poll() is None, p.communicate()
+        assert time.monotonic() < deadline, "the run never started"
+        time.sleep(0.05)
+    time.sleep(1.0)
     p.send_signal(signal.SIGTERM)
     _, err = p.communicate(timeout=60)
     assert p.returncode == 130, err
