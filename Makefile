@@ -8,7 +8,7 @@ BIN    := $(VENV)/bin
 OUT    ?= out
 RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
 
-.PHONY: run test test-rust test-python build reproduce elliptic-refs clean
+.PHONY: run test test-rust test-python build reproduce bench bench-quick elliptic-refs clean
 
 run: $(VENV)/.built
 	$(BIN)/phsplit simulate --out $(OUT)
@@ -36,6 +36,20 @@ $(VENV)/.built: $(VENV)/.deps $(RUST_SRC) python/pyproject.toml
 # The paper's §4: Figs. 2-4, the stability sweep and a report, in reproduction/.
 reproduce: $(VENV)/.built
 	$(BIN)/phsplit reproduce --out reproduction
+
+# Benchmarks (not part of `make test`): criterion micro-benchmarks of the core, then the
+# work-precision / stability / memory study against scipy and SUNDIALS CVODE, written to
+# benchmarks/results/ (CSV, Markdown summary, plots).
+$(VENV)/.bench-deps: $(VENV)/.deps benchmarks/requirements.txt
+	$(BIN)/python -m pip install --quiet -r benchmarks/requirements.txt
+	touch $@
+
+bench: $(VENV)/.built $(VENV)/.bench-deps
+	cargo bench -p phsplit-core --bench flows
+	$(BIN)/python benchmarks/work_precision.py
+
+bench-quick: $(VENV)/.built $(VENV)/.bench-deps
+	$(BIN)/python benchmarks/work_precision.py --quick --out benchmarks/results-quick
 
 # Regenerate the mpmath reference table of the elliptic functions (checked in).
 elliptic-refs: $(VENV)/.deps

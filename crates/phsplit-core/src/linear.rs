@@ -13,7 +13,7 @@
 //! `∫₀^h exp(Āᵀs) M exp(Ā s) ds = F₂₂ᵀ F₁₂`. Several forms share one exponential of
 //! `[[−Āᵀ, 0, M₁], [0, −Āᵀ, M₂], [0, 0, Ā]]`, whose top-right blocks are the `F₁₂` of each.
 
-use nalgebra::{Const, DMatrix, DimMin, SMatrix};
+use nalgebra::{Const, DMatrix, DVector, DimMin, SMatrix, SVector};
 
 /// The flow `exp(Ā h)` of the augmented system.
 pub fn flow<const M: usize>(abar: &SMatrix<f64, M, M>, h: f64) -> SMatrix<f64, M, M>
@@ -44,6 +44,131 @@ pub fn flow_with_integrals<const M: usize, const K: usize>(
     (f22, ints)
 }
 
+/// The flow `exp(Ā h)` of a 10-dimensional augmented system and the Gramian
+/// `Z = ∫₀^h z(s) z(s)ᵀ ds` of its trajectory from `z0`, from one 20×20 exponential
+/// (Van Loan 1978 with the state's outer product as the coupling block):
+/// `exp([[Ā, z0 z0ᵀ], [0, −Āᵀ]] h) = [[e^{Āh}, F₁₂], [0, e^{−Āᵀh}]]` and `Z = F₁₂ e^{Āᵀh}`.
+/// Then `∫ zᵀ M z ds = tr(M Z)` for any number of forms `M`, at the cost of one exponential.
+pub fn flow_and_gramian(
+    abar: &SMatrix<f64, 10, 10>,
+    z0: &SVector<f64, 10>,
+    h: f64,
+) -> (SMatrix<f64, 10, 10>, SMatrix<f64, 10, 10>) {
+    let mut c = SMatrix::<f64, 20, 20>::zeros();
+    c.fixed_view_mut::<10, 10>(0, 0).copy_from(&(abar * h));
+    c.fixed_view_mut::<10, 10>(0, 10)
+        .copy_from(&(z0 * z0.transpose() * h));
+    c.fixed_view_mut::<10, 10>(10, 10)
+        .copy_from(&(-abar.transpose() * h));
+    let e = c.exp();
+    let f11: SMatrix<f64, 10, 10> = e.fixed_view::<10, 10>(0, 0).into_owned();
+    let f12: SMatrix<f64, 10, 10> = e.fixed_view::<10, 10>(0, 10).into_owned();
+    (f11, f12 * f11.transpose())
+}
+
+/// `tr(M Z)` for symmetric `M`: the integral `∫ zᵀ M z ds` given the Gramian `Z`.
+pub fn trace_product(m: &SMatrix<f64, 10, 10>, z: &SMatrix<f64, 10, 10>) -> f64 {
+    m.component_mul(z).sum()
+}
+
+/// Gauss–Legendre collocation with `s` stages (`s = 1, 2, 3`; orders 2, 4, 6), on a linear
+/// system: its update is the diagonal `(s, s)` Padé approximant of the exponential, and for a
+/// port-Hamiltonian linear system it conserves the storage exactly where the system does and
+/// dissipates it where the system does (algebraic stability; paper Remark 2.3).
+pub mod gauss {
+    use super::*;
+
+    /// Butcher coefficients `(A, b)` of the `s`-stage Gauss method.
+    pub fn tableau(s: usize) -> (Vec<Vec<f64>>, Vec<f64>) {
+        match s {
+            1 => (vec![vec![0.5]], vec![1.0]),
+            2 => {
+                let r = 3f64.sqrt() / 6.0;
+                (
+                    vec![vec![0.25, 0.25 - r], vec![0.25 + r, 0.25]],
+                    vec![0.5, 0.5],
+                )
+            }
+            3 => {
+                let r = 15f64.sqrt();
+                (
+                    vec![
+                        vec![5.0 / 36.0, 2.0 / 9.0 - r / 15.0, 5.0 / 36.0 - r / 30.0],
+                        vec![5.0 / 36.0 + r / 24.0, 2.0 / 9.0, 5.0 / 36.0 - r / 24.0],
+                        vec![5.0 / 36.0 + r / 30.0, 2.0 / 9.0 + r / 15.0, 5.0 / 36.0],
+                    ],
+                    vec![5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0],
+                )
+            }
+            _ => panic!("Gauss collocation is provided with 1, 2 or 3 stages, not {s}"),
+        }
+    }
+
+    /// `z(h) ≈ R_s(hĀ) z0` with `R_s` the `(s, s)` Padé approximant: `P(X) z0` by
+    /// matrix–vector products, then one LU solve with `Q(X) = P(−X)`. Returns `None` if `Q(X)`
+    /// is singular (it is not for a dissipative `Ā`: its eigenvalues have `Re ≤ 0`).
+    pub fn step(
+        abar: &SMatrix<f64, 10, 10>,
+        z0: &SVector<f64, 10>,
+        h: f64,
+        s: usize,
+    ) -> Option<SVector<f64, 10>> {
+        let x = abar * h;
+        let i = SMatrix::<f64, 10, 10>::identity();
+        let v1 = x * z0;
+        let (rhs, q) = match s {
+            1 => (z0 + v1 * 0.5, i - x * 0.5),
+            2 => {
+                let x2 = x * x;
+                (z0 + v1 * 0.5 + x * v1 / 12.0, i - x * 0.5 + x2 / 12.0)
+            }
+            3 => {
+                let x2 = x * x;
+                let x3 = x2 * x;
+                let v2 = x * v1;
+                (
+                    z0 + v1 * 0.5 + v2 / 10.0 + x * v2 / 120.0,
+                    i - x * 0.5 + x2 / 10.0 - x3 / 120.0,
+                )
+            }
+            _ => panic!("Gauss collocation is provided with 1, 2 or 3 stages, not {s}"),
+        };
+        q.lu().solve(&rhs)
+    }
+
+    /// The collocation stages `Y_1..Y_s` and the update, from the `10s × 10s` stage equations
+    /// `Y_i = z0 + h Σ_j a_ij Ā Y_j`; `z1 = z0 + h Σ b_i Ā Y_i`. Used with the energy ledger:
+    /// for a quadratic storage, `H(z1) − H(z0) = h Σ b_i Ḣ(Y_i)` exactly.
+    pub fn stages(
+        abar: &SMatrix<f64, 10, 10>,
+        z0: &SVector<f64, 10>,
+        h: f64,
+        s: usize,
+    ) -> Option<(SVector<f64, 10>, Vec<SVector<f64, 10>>, Vec<f64>)> {
+        let (a, b) = tableau(s);
+        let n = 10 * s;
+        let mut m = DMatrix::<f64>::identity(n, n);
+        let mut rhs = DVector::<f64>::zeros(n);
+        for i in 0..s {
+            for j in 0..s {
+                let blk = abar * (-h * a[i][j]);
+                let mut v = m.view_mut((10 * i, 10 * j), (10, 10));
+                v += blk;
+            }
+            rhs.rows_mut(10 * i, 10).copy_from(z0);
+        }
+        let y = m.lu().solve(&rhs)?;
+        let ys: Vec<SVector<f64, 10>> = (0..s)
+            .map(|i| SVector::<f64, 10>::from_iterator(y.rows(10 * i, 10).iter().cloned()))
+            .collect();
+        let mut z1 = *z0;
+        for i in 0..s {
+            z1 += abar * ys[i] * (h * b[i]);
+        }
+        Some((z1, ys, b))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -66,6 +191,59 @@ mod tests {
         let z = e * SVector::<f64, 3>::new(y0, 0.0, 1.0);
         assert!((z[0] - y1).abs() < 1e-15);
         assert_eq!(z[2], 1.0);
+    }
+
+    fn example10() -> SMatrix<f64, 10, 10> {
+        // A damped oscillator chain with forcing in the last column (augmented form).
+        let mut a = SMatrix::<f64, 10, 10>::zeros();
+        for i in 0..9 {
+            a[(i, i)] = -0.1 * (i as f64 + 1.0);
+            if i + 1 < 9 {
+                a[(i, i + 1)] = 1.0;
+                a[(i + 1, i)] = -1.0;
+            }
+            a[(i, 9)] = 0.05 * i as f64;
+        }
+        a
+    }
+
+    #[test]
+    fn gramian_gives_the_same_integrals_as_van_loan() {
+        let a = example10();
+        let z0 = SVector::<f64, 10>::from_fn(|i, _| if i == 9 { 1.0 } else { (i as f64).sin() });
+        let m = SMatrix::<f64, 10, 10>::from_fn(|i, j| 1.0 / (1.0 + i as f64 + j as f64));
+        let h = 0.8;
+        let (f, z) = flow_and_gramian(&a, &z0, h);
+        let (f2, [g]) = flow_with_integrals(&a, &[m], h);
+        assert!((f - f2).norm() < 1e-13);
+        let via_gramian = trace_product(&m, &z);
+        let via_van_loan = z0.dot(&(g * z0));
+        assert!((via_gramian - via_van_loan).abs() < 1e-13 * via_van_loan.abs());
+    }
+
+    #[test]
+    fn gauss_pade_has_orders_2_4_6_and_matches_its_stages() {
+        let a = example10();
+        let z0 = SVector::<f64, 10>::from_fn(|i, _| if i == 9 { 1.0 } else { (i as f64).cos() });
+        for s in 1..=3 {
+            let mut errs = vec![];
+            for h in [0.4, 0.2, 0.1] {
+                let exact = flow(&a, h) * z0;
+                let z = gauss::step(&a, &z0, h, s).unwrap();
+                let (zs, _, _) = gauss::stages(&a, &z0, h, s).unwrap();
+                assert!(
+                    (z - zs).norm() < 1e-14 * z.norm(),
+                    "Padé and collocation agree"
+                );
+                errs.push((z - exact).norm());
+            }
+            // local error O(h^{2s+1})
+            let slope = (errs[0] / errs[2]).ln() / 4f64.ln();
+            assert!(
+                (slope - (2 * s + 1) as f64).abs() < 0.25,
+                "s={s}: slope {slope}, {errs:?}"
+            );
+        }
     }
 
     #[test]

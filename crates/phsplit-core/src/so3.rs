@@ -153,11 +153,20 @@ pub fn rodrigues(q: &Vector4<f64>) -> Matrix3<f64> {
 }
 
 /// The unit quaternion `(q0, q1, q2, q3)` (scalar first) of a rotation matrix, with the sign
-/// chosen so that `q0 ≥ 0`. A matrix that is only nearly orthogonal is first projected to the
-/// nearest rotation.
+/// chosen so that `q0 ≥ 0`. A matrix further than 1e-10 from orthogonal is first projected to
+/// the nearest rotation ([`orthonormalize`]); a rotation to round-off is converted as it is
+/// (projection would only add round-off). A non-finite matrix gives NaNs.
 pub fn quaternion(q: &Matrix3<f64>) -> Vector4<f64> {
-    let rot = Rotation3::from_matrix_eps(q, 1e-15, 100, Rotation3::identity());
-    let uq = UnitQuaternion::from_rotation_matrix(&rot);
+    let defect = orthogonality_defect(q);
+    let r = if defect.is_finite() && defect < 1e-10 {
+        *q
+    } else {
+        orthonormalize(q)
+    };
+    if !r.iter().all(|v| v.is_finite()) {
+        return Vector4::from_element(f64::NAN);
+    }
+    let uq = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
     let c = uq.quaternion().coords; // nalgebra stores (i, j, k, w)
     let mut out = Vector4::new(c[3], c[0], c[1], c[2]);
     if out[0] < 0.0 {
@@ -174,9 +183,29 @@ pub fn quat_mul(a: &Vector4<f64>, b: &Vector4<f64>) -> Vector4<f64> {
     Vector4::new(p.w, p.i, p.j, p.k)
 }
 
-/// Re-orthonormalise a nearly orthogonal matrix to the nearest rotation (polar factor).
+/// The nearest rotation to `q` in the Frobenius norm: the orthogonal polar factor `U Vᵀ` of the
+/// SVD `q = U Σ Vᵀ`, with the sign of the smallest singular direction flipped when `det q < 0`
+/// (Higham, *Functions of Matrices*, §8.1). Scale-invariant and finite-time for any input: a
+/// non-finite matrix gives NaNs. (nalgebra's iterative `Rotation3::from_matrix_eps` does not
+/// terminate on matrices of very large norm, such as a diverging Runge–Kutta attitude.)
 pub fn orthonormalize(q: &Matrix3<f64>) -> Matrix3<f64> {
-    Rotation3::from_matrix_eps(q, 1e-15, 100, Rotation3::identity()).into_inner()
+    let scale = q.amax();
+    if !scale.is_finite() || scale == 0.0 {
+        return Matrix3::from_element(f64::NAN);
+    }
+    let svd = (q / scale).svd(true, true);
+    let (Some(mut u), Some(v_t)) = (svd.u, svd.v_t) else {
+        return Matrix3::from_element(f64::NAN);
+    };
+    if (u * v_t).determinant() < 0.0 {
+        // nalgebra sorts singular values in decreasing order: flip the smallest direction.
+        let i = (0..3)
+            .min_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]))
+            .unwrap_or(2);
+        let mut col = u.column_mut(i);
+        col *= -1.0;
+    }
+    u * v_t
 }
 
 /// `‖QᵀQ − I‖_F`, the distance of `Q` from the orthogonal group.
@@ -245,7 +274,38 @@ mod tests {
         assert!((pi_e(&e) * pi_e_inv(&e) - Matrix3::identity()).norm() < 1e-15);
     }
 
+    #[test]
+    fn projection_terminates_on_huge_and_non_finite_matrices() {
+        let huge = Matrix3::new(
+            1e200, 3e199, -2e200, 5e199, 1e200, 7e199, -1e199, 2e200, 9e199,
+        );
+        let r = orthonormalize(&huge);
+        assert!(orthogonality_defect(&r) < 1e-14 && (r.determinant() - 1.0).abs() < 1e-14);
+        assert!(quaternion(&huge).iter().all(|v| v.is_finite()));
+        let mut bad = Matrix3::identity();
+        bad[(0, 1)] = f64::INFINITY;
+        assert!(quaternion(&bad).iter().all(|v| v.is_nan()));
+        assert!(quaternion(&Matrix3::zeros()).iter().all(|v| v.is_nan()));
+        // A reflection is mapped to a proper rotation.
+        let refl = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0))
+            * exp(&Vector3::new(0.1, 0.2, 0.3));
+        assert!((orthonormalize(&refl).determinant() - 1.0).abs() < 1e-14);
+    }
+
     proptest! {
+        #[test]
+        fn projection_is_the_nearest_rotation(w in v3().prop_map(|v| v * 3.0), e in proptest::array::uniform9(-1e-3f64..1e-3)) {
+            let r = exp(&w);
+            let noisy = r + Matrix3::from_column_slice(&e);
+            let p = orthonormalize(&noisy);
+            prop_assert!(orthogonality_defect(&p) < 1e-14);
+            // The projection of a rotation is itself, and a perturbed one moves by O(noise).
+            prop_assert!((orthonormalize(&r) - r).norm() < 1e-14);
+            prop_assert!((p - r).norm() < 3e-3);
+            // Nearest: no closer than the original rotation to the noisy matrix.
+            prop_assert!((noisy - p).norm() <= (noisy - r).norm() + 1e-15);
+        }
+
         #[test]
         fn exp_is_orthogonal_and_log_inverts(w in v3().prop_map(|v| v * 3.0)) {
             let r = exp(&w);

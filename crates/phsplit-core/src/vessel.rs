@@ -328,6 +328,19 @@ impl Vessel {
     }
 }
 
+/// How flow S2 (linear) is integrated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinearFlow {
+    /// The exact flow: a matrix exponential per sub-step (paper §3.4.2).
+    #[default]
+    Exact,
+    /// Gauss–Legendre collocation (the diagonal Padé approximant of the exponential) with as
+    /// many stages as the composition needs (`⌈order/2⌉`): cheaper, of the composition's order,
+    /// and still energy-dissipative on S2, so the passivity of the composition is kept (paper
+    /// Remark 2.3). The ledger stays exact (Gauss quadrature of a quadratic storage).
+    Gauss,
+}
+
 /// The vessel as a dynamical system: the vessel plus the controller schedule.
 #[derive(Debug, Clone)]
 pub struct VesselSystem<'a> {
@@ -335,6 +348,10 @@ pub struct VesselSystem<'a> {
     /// The controller (and the growth of the integral states) acts on steps that start at or
     /// after this time; `None` keeps it off throughout.
     pub control_start: Option<f64>,
+    /// How flow S2 is integrated.
+    pub linear: LinearFlow,
+    /// Stages of Gauss collocation when `linear` is `Gauss` (1, 2 or 3).
+    pub gauss_stages: usize,
 }
 
 /// The controller quantities at a given attitude: `W = Pi_e(theta)⁻¹ Q` and the
@@ -358,7 +375,16 @@ impl<'a> VesselSystem<'a> {
         Self {
             vessel,
             control_start,
+            linear: LinearFlow::Exact,
+            gauss_stages: 1,
         }
+    }
+
+    /// The same system with flow S2 integrated by `linear`, to order at least `order`.
+    pub fn with_linear_flow(mut self, linear: LinearFlow, order: usize) -> Self {
+        self.linear = linear;
+        self.gauss_stages = order.div_ceil(2).clamp(1, 3);
+        self
     }
 
     /// Whether the controller acts on a step that starts at `t`.
@@ -560,8 +586,9 @@ impl<'a> VesselSystem<'a> {
         ]
     }
 
-    /// Exact flow S2 over `h` (paper §3.4.2): two affine systems solved by matrix exponentials.
-    /// With `ledger`, also the exact supplied and dissipated energy over the sub-step.
+    /// Flow S2 over `h` (paper §3.4.2): two affine systems solved by matrix exponentials
+    /// (or Gauss collocation, see [`LinearFlow`]). With `ledger`, also the supplied and
+    /// dissipated energy over the sub-step, exactly (Van Loan Gramian, or Gauss quadrature).
     pub fn flow_s2(&self, s: &mut VesselState, h: f64, on: bool, ledger: bool) -> Power {
         let [bt, br] = self.s2_systems(&s.q, on);
         let mut zt = SVector::<f64, 10>::zeros();
@@ -575,18 +602,13 @@ impl<'a> VesselSystem<'a> {
         zr.fixed_rows_mut::<3>(3).copy_from(&s.mu);
         zr.fixed_rows_mut::<3>(6).copy_from(&s.phi_th);
         zr[9] = 1.0;
-        let mut work = Power::default();
-        let (et, er) = if ledger {
-            let (et, [st, dt]) = bt.flow_with_integrals(h);
-            let (er, [sr, dr]) = br.flow_with_integrals(h);
-            work.supplied = zt.dot(&(st * zt)) + zr.dot(&(sr * zr));
-            work.dissipated = zt.dot(&(dt * zt)) + zr.dot(&(dr * zr));
-            (et, er)
-        } else {
-            (bt.flow(h), br.flow(h))
+        let stages = self.gauss_stages;
+        let (zt, wt) = bt.advance(&zt, h, self.linear, stages, ledger);
+        let (zr, wr) = br.advance(&zr, h, self.linear, stages, ledger);
+        let work = Power {
+            supplied: wt.supplied + wr.supplied,
+            dissipated: wt.dissipated + wr.dissipated,
         };
-        let zt = et * zt;
-        let zr = er * zr;
         s.p = zt.fixed_rows::<3>(0).into();
         s.x = xr + zt.fixed_rows::<3>(3);
         s.phi_x = zt.fixed_rows::<3>(6).into();
@@ -612,26 +634,55 @@ impl S2Block {
         let s = &self.scale;
         SMatrix::from_fn(|i, j| self.abar[(i, j)] * s[j] / s[i])
     }
-    /// `exp(Ā h) = S exp(S⁻¹ĀS h) S⁻¹`.
-    fn unbalance(&self, e: &SMatrix<f64, 10, 10>) -> SMatrix<f64, 10, 10> {
+    /// A form `M` in balanced variables: `z̃ᵀ (S M S) z̃ = zᵀ M z`.
+    fn balanced_form(&self, m: &SMatrix<f64, 10, 10>) -> SMatrix<f64, 10, 10> {
         let s = &self.scale;
-        SMatrix::from_fn(|i, j| e[(i, j)] * s[i] / s[j])
+        SMatrix::from_fn(|i, j| m[(i, j)] * s[i] * s[j])
     }
-    fn flow(&self, h: f64) -> SMatrix<f64, 10, 10> {
-        self.unbalance(&linear::flow(&self.balanced(), h))
-    }
-    /// The flow and the Gram integrals of the supplied and dissipated forms; in balanced
-    /// variables the forms are `S M S`, and `G = S⁻¹ G̃ S⁻¹` takes them back.
-    fn flow_with_integrals(&self, h: f64) -> (SMatrix<f64, 10, 10>, [SMatrix<f64, 10, 10>; 2]) {
-        let s = &self.scale;
-        let fwd = |m: &SMatrix<f64, 10, 10>| SMatrix::from_fn(|i, j| m[(i, j)] * s[i] * s[j]);
-        let back = |m: &SMatrix<f64, 10, 10>| SMatrix::from_fn(|i, j| m[(i, j)] / (s[i] * s[j]));
-        let (e, [gs, gd]) = linear::flow_with_integrals(
-            &self.balanced(),
-            &[fwd(&self.supplied), fwd(&self.dissipated)],
-            h,
-        );
-        (self.unbalance(&e), [back(&gs), back(&gd)])
+
+    /// Advance `z` over `h` by the exact flow or Gauss collocation with `stages` stages; with
+    /// `ledger`, also the supplied and dissipated energy. A singular collocation system (not
+    /// possible for a dissipative system, but checked) yields a non-finite state.
+    fn advance(
+        &self,
+        z: &SVector<f64, 10>,
+        h: f64,
+        kind: LinearFlow,
+        stages: usize,
+        ledger: bool,
+    ) -> (SVector<f64, 10>, Power) {
+        let sc = &self.scale;
+        let zb = z.component_div(sc);
+        let a = self.balanced();
+        let mut work = Power::default();
+        let zb1 = match (kind, ledger) {
+            (LinearFlow::Exact, false) => Some(linear::flow(&a, h) * zb),
+            (LinearFlow::Exact, true) => {
+                let (f, gram) = linear::flow_and_gramian(&a, &zb, h);
+                work.supplied = linear::trace_product(&self.balanced_form(&self.supplied), &gram);
+                work.dissipated =
+                    linear::trace_product(&self.balanced_form(&self.dissipated), &gram);
+                Some(f * zb)
+            }
+            (LinearFlow::Gauss, false) => linear::gauss::step(&a, &zb, h, stages),
+            (LinearFlow::Gauss, true) => {
+                linear::gauss::stages(&a, &zb, h, stages).map(|(z1, ys, b)| {
+                    let (ms, md) = (
+                        self.balanced_form(&self.supplied),
+                        self.balanced_form(&self.dissipated),
+                    );
+                    for (y, bi) in ys.iter().zip(b) {
+                        work.supplied += h * bi * y.dot(&(ms * y));
+                        work.dissipated += h * bi * y.dot(&(md * y));
+                    }
+                    z1
+                })
+            }
+        };
+        match zb1 {
+            Some(v) => (v.component_mul(sc), work),
+            None => (SVector::from_element(f64::NAN), work),
+        }
     }
 }
 

@@ -9,7 +9,9 @@ use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use phsplit_core::integrate::{run, Options, Status};
 use phsplit_core::methods::{Method, Outer, METHOD_NAMES};
 use phsplit_core::so3;
-use phsplit_core::vessel::{Vessel, VesselState, VesselSystem, PAPER_VESSEL_TOML, STATE_DIM};
+use phsplit_core::vessel::{
+    LinearFlow, Vessel, VesselState, VesselSystem, PAPER_VESSEL_TOML, STATE_DIM,
+};
 use phsplit_core::Error;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
@@ -166,10 +168,13 @@ impl PyVessel {
     }
 }
 
+/// The entries of a 1-D array, contiguous or strided.
+fn entries(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    a.as_array().iter().copied().collect()
+}
+
 fn flat_state(a: &PyReadonlyArray1<'_, f64>) -> PyResult<VesselState> {
-    let s = a
-        .as_slice()
-        .map_err(|e| InvalidInputError::new_err(e.to_string()))?;
+    let s = &entries(a)[..];
     if s.len() != STATE_DIM {
         return Err(InvalidInputError::new_err(format!(
             "a state is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x), got {}",
@@ -218,7 +223,7 @@ fn method_info<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>>
 
 /// Integrate; returns a dict of numpy arrays. The GIL is released while integrating.
 #[pyfunction]
-#[pyo3(signature = (vessel, t0, h, n_steps, method, control_start, outer, save_every, ledger, state0))]
+#[pyo3(signature = (vessel, t0, h, n_steps, method, control_start, outer, save_every, ledger, state0, linear_flow="exact"))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -232,8 +237,19 @@ fn integrate<'py>(
     save_every: usize,
     ledger: bool,
     state0: PyReadonlyArray1<'_, f64>,
+    linear_flow: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::by_name(method).map_err(to_py)?;
+    let linear = match linear_flow {
+        "exact" => LinearFlow::Exact,
+        "gauss" => LinearFlow::Gauss,
+        other => {
+            return Err(InvalidInputError::new_err(format!(
+                "linear_flow must be 'exact' (matrix exponential) or 'gauss' (Gauss collocation / diagonal Padé), got {other:?}"
+            )))
+        }
+    };
+    let order = method.order();
     let outer = match outer {
         "dissipative" | "S2" | "s2" => Outer::Dissipative,
         "conservative" | "S1" | "s1" => Outer::Conservative,
@@ -268,7 +284,7 @@ fn integrate<'py>(
     let v = vessel.inner.clone();
     let traj = py
         .detach(move || {
-            let sys = VesselSystem::new(&v, control_start);
+            let sys = VesselSystem::new(&v, control_start).with_linear_flow(linear, order);
             run(&sys, &method, y0, &opts)
         })
         .map_err(to_py)?;
@@ -327,6 +343,74 @@ fn integrate<'py>(
     Ok(d)
 }
 
+/// A compiled right-hand side `f(t, y)` of eq. (39) for external solvers (scipy, CVODE):
+/// `y` a flat 27-vector; the controller acts from `control_start` (None: never).
+#[pyclass(name = "VectorField", module = "phsplit._core", frozen)]
+struct PyVectorField {
+    vessel: Vessel,
+    control_start: Option<f64>,
+}
+
+#[pymethods]
+impl PyVectorField {
+    #[new]
+    #[pyo3(signature = (vessel, control_start=None))]
+    fn new(vessel: &PyVessel, control_start: Option<f64>) -> Self {
+        Self {
+            vessel: vessel.inner.clone(),
+            control_start,
+        }
+    }
+    /// `y' = f(t, y)` as a new array.
+    fn __call__<'py>(
+        &self,
+        py: Python<'py>,
+        t: f64,
+        y: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let s = state_any(&y)?;
+        let sys = VesselSystem::new(&self.vessel, self.control_start);
+        let d = sys.vector_field(&s, sys.control_on(t)).to_vector();
+        Ok(PyArray1::from_slice(py, d.as_slice()))
+    }
+    /// `f(t, y)` written into `out` (the CVODE calling convention `f(t, y, yp)`).
+    fn into(
+        &self,
+        t: f64,
+        y: PyReadonlyArray1<'_, f64>,
+        mut out: numpy::PyReadwriteArray1<'_, f64>,
+    ) -> PyResult<()> {
+        let s = state_any(&y)?;
+        let sys = VesselSystem::new(&self.vessel, self.control_start);
+        let d = sys.vector_field(&s, sys.control_on(t)).to_vector();
+        let o = out
+            .as_slice_mut()
+            .map_err(|e| InvalidInputError::new_err(e.to_string()))?;
+        if o.len() != STATE_DIM {
+            return Err(InvalidInputError::new_err(format!(
+                "out must have {STATE_DIM} entries, got {}",
+                o.len()
+            )));
+        }
+        o.copy_from_slice(d.as_slice());
+        Ok(())
+    }
+}
+
+/// A 27-vector state without the finiteness check (solvers probe freely).
+fn state_any(a: &PyReadonlyArray1<'_, f64>) -> PyResult<VesselState> {
+    let s = &entries(a)[..];
+    if s.len() != STATE_DIM {
+        return Err(InvalidInputError::new_err(format!(
+            "a state is a flat vector of {STATE_DIM} numbers, got {}",
+            s.len()
+        )));
+    }
+    Ok(VesselState::from_vector(
+        &nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(s),
+    ))
+}
+
 /// Euler angles (ZYX: roll, pitch, yaw) of a 3×3 attitude matrix, eq. (21).
 #[pyfunction]
 fn euler_zyx(q: [[f64; 3]; 3]) -> [f64; 3] {
@@ -338,6 +422,7 @@ fn euler_zyx(q: [[f64; 3]; 3]) -> [f64; 3] {
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyVessel>()?;
+    m.add_class::<PyVectorField>()?;
     m.add_function(wrap_pyfunction!(integrate, m)?)?;
     m.add_function(wrap_pyfunction!(method_info, m)?)?;
     m.add_function(wrap_pyfunction!(euler_zyx, m)?)?;

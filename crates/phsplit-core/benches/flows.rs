@@ -1,0 +1,92 @@
+//! Micro-benchmarks of the core: each flow, the vector field, and one step of every method on
+//! the paper's vessel (controller on). Run: `cargo bench -p phsplit-core --bench flows`
+//! (or `make bench`); criterion prints the time per call.
+use criterion::{criterion_group, criterion_main, Criterion};
+use nalgebra::{Matrix3, Vector3};
+use phsplit_core::elliptic::jacobi;
+use phsplit_core::integrate::{run, Options};
+use phsplit_core::methods::{Method, Outer, METHOD_NAMES};
+use phsplit_core::rigid_body::MagnusOrder;
+use phsplit_core::vessel::{LinearFlow, Vessel, VesselSystem};
+use std::hint::black_box;
+
+fn flows(c: &mut Criterion) {
+    let vessel = Vessel::paper();
+    let mut y0 = vessel.initial_state();
+    y0.m = Vector3::new(2e6, -1e6, 3e6); // a moving body: the elliptic path, not a fixed point
+    y0.p = Vector3::new(1e6, 2e5, 0.0);
+    let body = *vessel.body();
+    let q0 = Matrix3::identity();
+    c.bench_function("jacobi sn cn dn (m = 0.7)", |b| {
+        b.iter(|| jacobi(black_box(1.3), black_box(0.7)))
+    });
+    c.bench_function("free rigid body orbit setup", |b| {
+        b.iter(|| body.orbit(black_box(&y0.m)))
+    });
+    for (name, order) in [
+        ("2", MagnusOrder::Two),
+        ("4", MagnusOrder::Four),
+        ("6", MagnusOrder::Six),
+    ] {
+        c.bench_function(&format!("flow S1: free rigid body + Magnus {name}"), |b| {
+            b.iter(|| body.flow(black_box(&y0.m), black_box(&q0), black_box(0.5), order))
+        });
+    }
+    let sys = VesselSystem::new(&vessel, Some(0.0));
+    c.bench_function("vector field (eq. 39)", |b| {
+        b.iter(|| sys.vector_field(black_box(&y0), true))
+    });
+    for (name, lf, order) in [
+        ("exact", LinearFlow::Exact, 2),
+        ("gauss s=1", LinearFlow::Gauss, 2),
+        ("gauss s=2", LinearFlow::Gauss, 4),
+        ("gauss s=3", LinearFlow::Gauss, 6),
+    ] {
+        let sys = VesselSystem::new(&vessel, Some(0.0)).with_linear_flow(lf, order);
+        for ledger in [false, true] {
+            c.bench_function(
+                &format!("flow S2: {name}{}", if ledger { " + ledger" } else { "" }),
+                |b| {
+                    b.iter(|| {
+                        let mut s = y0;
+                        sys.flow_s2(&mut s, black_box(0.5), true, ledger)
+                    })
+                },
+            );
+        }
+    }
+    // One step of every method, measured as 1,000 steps / 1,000 with decimated saving.
+    for name in METHOD_NAMES {
+        let method = Method::by_name(name).unwrap();
+        let variants: &[LinearFlow] = match method {
+            Method::Splitting(_) => &[LinearFlow::Exact, LinearFlow::Gauss],
+            Method::RungeKutta(_) => &[LinearFlow::Exact],
+        };
+        for &lf in variants {
+            let sys = VesselSystem::new(&vessel, Some(0.0)).with_linear_flow(lf, method.order());
+            let opts = Options {
+                t0: 0.0,
+                h: 0.5,
+                n_steps: 1000,
+                save_every: 1000,
+                outer: Outer::Dissipative,
+                ledger: false,
+            };
+            let label = match (&method, lf) {
+                (Method::RungeKutta(_), _) => format!("1000 steps: {name}"),
+                (_, LinearFlow::Exact) => format!("1000 steps: {name} (exact S2)"),
+                (_, LinearFlow::Gauss) => format!("1000 steps: {name} (gauss S2)"),
+            };
+            c.bench_function(&label, |b| {
+                b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
+            });
+        }
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2)).warm_up_time(std::time::Duration::from_millis(500));
+    targets = flows
+}
+criterion_main!(benches);
