@@ -220,14 +220,17 @@ def stability(quick: bool) -> list[dict]:
 
 
 MEM_CHILD = """
-import resource, time, phsplit
+import time, phsplit
+def hwm_kb():  # this process's own peak RSS (ru_maxrss would include the forking parent's)
+    with open("/proc/self/status") as f:
+        return int(next(l.split()[1] for l in f if l.startswith("VmHWM")))
 v = phsplit.Vessel.paper()
 t0 = time.perf_counter()
 s = phsplit.simulate(v, (0.0, {T}), {h}, "sp2", control_start=0.0, ledger=True, save_every={k},
                      linear_flow="gauss")
 dt = time.perf_counter() - t0
 import numpy as np
-print(s.steps, len(s.t), dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss,
+print(s.steps, len(s.t), dt, hwm_kb(),
       float(s.orthogonality_defect.max()), float(s.ledger.relative_residual().max()))
 """
 

@@ -144,6 +144,19 @@ pub fn pi_e_inv(e: &Vector3<f64>) -> Matrix3<f64> {
     )
 }
 
+/// `Pi_e(theta)⁻¹` at the ZYX angles of `q`, without evaluating them: the sines and cosines of
+/// the `atan2`s of [`euler_zyx`] are ratios of entries of `q`
+/// (`cos ψ = Q11/ρ, sin ψ = Q21/ρ, ρ = hypot(Q11, Q21)`; `cos θ = ρ/r, sin θ = −Q31/r`,
+/// `r = |first column|`). Equals `pi_e_inv(&euler_zyx(q))` to rounding, with no trigonometry.
+pub fn pi_e_inv_of(q: &Matrix3<f64>) -> Matrix3<f64> {
+    let rho = q[(0, 0)].hypot(q[(1, 0)]);
+    let r = rho.hypot(q[(2, 0)]);
+    let (cp, sp) = (q[(0, 0)] / rho, q[(1, 0)] / rho);
+    let tt = -q[(2, 0)] / rho; // tan θ
+    let sec = r / rho; // 1 / cos θ
+    Matrix3::new(cp * sec, sp * sec, 0.0, -sp, cp, 0.0, cp * tt, sp * tt, 1.0)
+}
+
 /// Euler–Rodrigues map `E(q) = I + 2 q0 hat(qv) + 2 hat(qv)^2` for a unit quaternion
 /// `q = (q0, qv)` (paper Appendix A).
 pub fn rodrigues(q: &Vector4<f64>) -> Matrix3<f64> {
@@ -272,6 +285,11 @@ mod tests {
         let omega_spatial = vee(&(qd * q.transpose()));
         assert!((pi_e(&e) * ed - omega_spatial).norm() < 1e-9);
         assert!((pi_e(&e) * pi_e_inv(&e) - Matrix3::identity()).norm() < 1e-15);
+        // The trig-free form agrees, also for a matrix that is only nearly orthogonal.
+        assert!((pi_e_inv_of(&q) - pi_e_inv(&e)).norm() < 1e-15);
+        let mut nq = q * 1.001;
+        nq[(2, 0)] += 1e-4;
+        assert!((pi_e_inv_of(&nq) - pi_e_inv(&euler_zyx(&nq))).norm() < 1e-14);
     }
 
     #[test]

@@ -402,7 +402,7 @@ impl<'a> VesselSystem<'a> {
             q: *q,
             q3: q.transpose() * Vector3::z(),
             theta_err: theta - theta_ref,
-            w_mat: so3::pi_e_inv(&theta) * q,
+            w_mat: so3::pi_e_inv_of(q) * q,
         }
     }
 
@@ -428,9 +428,38 @@ impl<'a> VesselSystem<'a> {
 
     /// The full vector field, eq. (39), with the controller on or off.
     pub fn vector_field(&self, s: &VesselState, on: bool) -> VesselState {
-        let a = self.split_field(s, on, Flow::S1);
-        let b = self.split_field(s, on, Flow::S2);
-        VesselState::from_vector(&(a.to_vector() + b.to_vector()))
+        // One pass over eq. (39); `split_field` gives the two halves (tested to add up to this).
+        let vsl = self.vessel;
+        let v = s.p / vsl.hull.mass;
+        let w = vsl.body.omega(&s.m);
+        let f = self.frozen(&s.q);
+        let c = &vsl.control;
+        let k = if on { 1.0 } else { 0.0 };
+        let d = |a: [f64; 3]| Vector3::from(a) * k;
+        let xr = Vector3::from(c.position_reference);
+        let ex = s.x - xr;
+        let qv = f.q * v;
+        let tau_t = -f.q.transpose()
+            * (d(c.kp_translational).component_mul(&ex)
+                + d(c.kd_translational).component_mul(&qv)
+                + d(c.ki_translational).component_mul(&s.phi_x));
+        let ww = f.w_mat * w;
+        let tau_r = -f.w_mat.transpose()
+            * (d(c.kp_rotational).component_mul(&f.theta_err)
+                + d(c.kd_rotational).component_mul(&ww)
+                + d(c.ki_rotational).component_mul(&s.phi_th));
+        let dt = Vector3::from(vsl.hull.damping_translational);
+        let dr = Vector3::from(vsl.hull.damping_rotational);
+        let lam_x = Vector3::new(0.0, 0.0, vsl.heave_stiffness() * s.x.z);
+        VesselState {
+            p: -w.cross(&s.p) - (dt.component_mul(&v) + f.q.transpose() * lam_x - tau_t),
+            m: -w.cross(&s.m) - (dr.component_mul(&w) + s.mu.cross(&f.q3) - tau_r),
+            q: s.q * so3::hat(&w),
+            mu: -vsl.g_diag().component_mul(&w.cross(&f.q3)),
+            x: qv,
+            phi_th: f.theta_err * k,
+            phi_x: ex * k,
+        }
     }
 
     /// The vector field of flow S1 (eq. 40) or S2 (eq. 41) at `s`. Their sum is eq. (39).
@@ -632,7 +661,8 @@ struct S2Block {
 impl S2Block {
     fn balanced(&self) -> SMatrix<f64, 10, 10> {
         let s = &self.scale;
-        SMatrix::from_fn(|i, j| self.abar[(i, j)] * s[j] / s[i])
+        let inv = s.map(|v| 1.0 / v);
+        SMatrix::from_fn(|i, j| self.abar[(i, j)] * s[j] * inv[i])
     }
     /// A form `M` in balanced variables: `z̃ᵀ (S M S) z̃ = zᵀ M z`.
     fn balanced_form(&self, m: &SMatrix<f64, 10, 10>) -> SMatrix<f64, 10, 10> {
@@ -759,6 +789,9 @@ mod tests {
             }.to_vector();
             let scale = expect.norm();
             prop_assert!((full - expect).norm() <= 1e-13 * scale, "field mismatch {}", (full - expect).norm() / scale);
+            // The halves of the split add up to the full field.
+            let sum = sys.split_field(&s, on, Flow::S1).to_vector() + sys.split_field(&s, on, Flow::S2).to_vector();
+            prop_assert!((sum - full).norm() <= 1e-14 * scale, "S1 + S2 != full: {}", (sum - full).norm() / scale);
             // The exact S2 flow has the S2 field as its derivative at h = 0 (centred difference).
             let e = 1e-3;
             let (mut a, mut b) = (s, s);
