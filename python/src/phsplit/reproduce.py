@@ -105,9 +105,10 @@ def _rel(a: np.ndarray, b: np.ndarray) -> float:
 
 def fit_order(hs: np.ndarray, errs: np.ndarray, order: int, floor: float) -> tuple[float, int, int]:
     """Observed order: the log-log slope over the three finest points of the longest run of
-    consecutive halvings that each gain at least 2^(order-1) while the error stays above
-    ``floor`` (the reference's accuracy). Returns (slope, first, last) point indices."""
-    good = [errs[i - 1] / errs[i] >= 2.0 ** (order - 1) and errs[i] > floor for i in range(1, len(errs))]
+    consecutive halvings whose local slopes are each at least ``order - 0.5`` while the error
+    stays above ``floor`` (the reference's accuracy). Round-off ends such a run; a method of the
+    wrong order forms none (NaN). Returns (slope, first, last) point indices."""
+    good = [errs[i - 1] / errs[i] >= 2.0 ** (order - 0.5) and errs[i] > floor for i in range(1, len(errs))]
     best = (0, 0)
     run = 0
     for i, g in enumerate(good):
@@ -519,7 +520,7 @@ def render_report(res: Results, vessel: Vessel) -> str:
              f" (relative). The paper's reference, RK4 with h = {s.h_ref_order:g} in phsplit's core, agrees with it to " +
              ", ".join(f"{v} {res.order_rk4_crosscheck[v]:.1e}" for v in ("m", "q", "p", "x")) +  # type: ignore[attr-defined]
              ". Each slope is fitted on the three finest "
-             "points of the longest run of halvings that each gain at least 2^(order−1) above 3× that accuracy, "
+             "points of the longest run of halvings with local slopes ≥ order − 0.5 above 3× that accuracy, "
              "so round-off and the pre-asymptotic single step at h = 1 are left out.")
     L.append("")
     L.append("## Fig. 4: energy and control at long steps")
