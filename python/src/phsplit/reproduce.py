@@ -107,7 +107,8 @@ def fit_order(hs: np.ndarray, errs: np.ndarray, order: int, floor: float) -> tup
     """Observed order: the log-log slope over the three finest points of the longest run of
     consecutive halvings whose local slopes are each at least ``order - 0.5`` while the error
     stays above ``floor`` (the reference's accuracy). Round-off ends such a run; a method of the
-    wrong order forms none (NaN). Returns (slope, first, last) point indices."""
+    wrong order forms none (NaN). With five or more points in the run its finest point, the one
+    nearest round-off, is left out. Returns (slope, first, last) point indices."""
     good = [errs[i - 1] / errs[i] >= 2.0 ** (order - 0.5) and errs[i] > floor for i in range(1, len(errs))]
     best = (0, 0)
     run = 0
@@ -119,6 +120,8 @@ def fit_order(hs: np.ndarray, errs: np.ndarray, order: int, floor: float) -> tup
     if n_int < 2:
         return math.nan, 0, 0
     hi = first + n_int + 1
+    if hi - first >= 5:
+        hi -= 1  # the finest point of a long run is the one nearest round-off
     lo = max(first, hi - 3)
     slope = float(np.polyfit(np.log(hs[lo:hi]), np.log(errs[lo:hi]), 1)[0])
     return slope, lo, hi - 1
@@ -520,7 +523,8 @@ def render_report(res: Results, vessel: Vessel) -> str:
              f" (relative). The paper's reference, RK4 with h = {s.h_ref_order:g} in phsplit's core, agrees with it to " +
              ", ".join(f"{v} {res.order_rk4_crosscheck[v]:.1e}" for v in ("m", "q", "p", "x")) +  # type: ignore[attr-defined]
              ". Each slope is fitted on the three finest "
-             "points of the longest run of halvings with local slopes ≥ order − 0.5 above 3× that accuracy, "
+             "points of the longest run of halvings with local slopes ≥ order − 0.5 above 3× that accuracy "
+             "(without the run's finest point when it has five or more), "
              "so round-off and the pre-asymptotic single step at h = 1 are left out.")
     L.append("")
     L.append("## Fig. 4: energy and control at long steps")
