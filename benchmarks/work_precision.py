@@ -5,7 +5,8 @@ Run with ``make bench`` (or ``.venv/bin/python benchmarks/work_precision.py [--q
 Writes into ``benchmarks/results/``:
 
 * ``work_precision.csv``: one row per run: interval, solver, variant, right-hand side,
-  step or tolerance, wall time (median of repeats, s), final error;
+  step or tolerance, wall time (median of repeats, s), final error (``inf``: failed, or stopped
+  at the cap of 20 s per external-solver run);
 * ``stability.csv``: for every method and step size, whether the energy stayed below its
   passivity bound over [0, 3600] s;
 * ``summary.md``: the tables, the targets of the speed issue with measured values, the machine
@@ -118,6 +119,38 @@ def fixed_step_runs(ref_: Reference, quick: bool) -> list[dict]:
     return rows
 
 
+class OverBudget(Exception):
+    pass
+
+
+def capped(f, seconds: float, arity: int = 2):
+    """Wrap a right-hand side so that a run stops once it has used `seconds` of wall time.
+    `arity` 2 is scipy's f(t, y); 3 is CVODE's f(t, y, yp), whose signature it inspects."""
+    start = [0.0]
+
+    def check():
+        if time.perf_counter() - start[0] > seconds:
+            raise OverBudget
+
+    if arity == 2:
+        def g(t, y):
+            check()
+            return f(t, y)
+    else:
+        def g(t, y, yp):
+            check()
+            return f(t, y, yp)
+
+    def arm():
+        start[0] = time.perf_counter()
+
+    g.arm = arm  # type: ignore[attr-defined]
+    return g
+
+
+CAP = 20.0  # seconds per external-solver run (5 with --quick)
+
+
 def scipy_runs(ref_: Reference, quick: bool) -> list[dict]:
     from scipy.integrate import solve_ivp
 
@@ -126,14 +159,21 @@ def scipy_runs(ref_: Reference, quick: bool) -> list[dict]:
     rhs = {"numpy": ref.Field(PARAMS, True), "core": _core.VectorField(VESSEL._inner, 0.0)}
     scale = np.maximum(np.abs(Y0), 1.0)
     tols = [1e-4, 1e-6, 1e-8, 1e-10] if not quick else [1e-5, 1e-7]
+    cap = 5.0 if quick else CAP
     for method in ("RK45", "DOP853", "LSODA", "Radau"):
-        for name, f in rhs.items():
+        for name, f0 in rhs.items():
             for rtol in tols:
+                f = capped(f0, cap)
+
                 def run():
-                    return solve_ivp(f, (0.0, T), Y0, method=method, rtol=rtol, atol=rtol * scale * 1e-3)
+                    f.arm()
+                    try:
+                        return solve_ivp(f, (0.0, T), Y0, method=method, rtol=rtol, atol=rtol * scale * 1e-3)
+                    except OverBudget:
+                        return None
 
                 sec, sol = timed(run, min_repeats=1, budget=0.0)
-                err = ref_.error(sol.y[:, -1]) if sol.success else math.inf
+                err = ref_.error(sol.y[:, -1]) if sol is not None and sol.success else math.inf
                 rows.append({"T": T, "solver": f"scipy {method}", "variant": "-", "rhs": name, "param": rtol,
                              "seconds": sec, "error": err})
                 if sec > (10.0 if not quick else 2.0):
@@ -160,15 +200,22 @@ def cvode_runs(ref_: Reference, quick: bool) -> list[dict]:
 
     scale = np.maximum(np.abs(Y0), 1.0)
     tols = [1e-4, 1e-6, 1e-8, 1e-10] if not quick else [1e-5, 1e-7]
+    cap = 5.0 if quick else CAP
     for method in ("Adams", "BDF"):
-        for name, f in (("numpy", rhs_numpy), ("core", rhs_core)):
+        for name, f0 in (("numpy", rhs_numpy), ("core", rhs_core)):
             for rtol in tols:
+                f = capped(f0, cap, arity=3)
+
                 def run():
+                    f.arm()
                     solver = CVODE(f, method=method, rtol=rtol, atol=rtol * scale * 1e-3, max_num_steps=10**7)
-                    return solver.solve(np.array([0.0, T]), Y0)
+                    try:
+                        return solver.solve(np.array([0.0, T]), Y0)
+                    except Exception:  # OverBudget raised inside the callback surfaces here
+                        return None
 
                 sec, sol = timed(run, min_repeats=1, budget=0.0)
-                ok = bool(getattr(sol, "success", False))
+                ok = sol is not None and bool(getattr(sol, "success", False))
                 err = ref_.error(np.asarray(sol.y)[-1]) if ok else math.inf
                 rows.append({"T": T, "solver": f"CVODE {method}", "variant": "-", "rhs": name, "param": rtol,
                              "seconds": sec, "error": err})

@@ -139,3 +139,53 @@ def test_vector_field_binding_matches_the_independent_model():
     np.testing.assert_array_equal(f(1.0, Y[:, 0]), f(1.0, y))
     g0 = ref.Field(v.to_dict(), False)
     np.testing.assert_allclose(f(-1.0, y), g0(-1.0, y), rtol=0, atol=1e-13 * np.abs(g0(-1.0, y)).max())
+
+
+def test_chunked_cli_output_equals_one_simulate_call(tmp_path):
+    assert main(["simulate", "--out", str(tmp_path), "--no-plot", "--save-every", "3"]) == 0
+    s = phsplit.simulate(phsplit.Vessel.paper(), save_every=3)
+    with xr.open_dataset(tmp_path / "fig2.nc") as ds:
+        np.testing.assert_array_equal(ds["time"].values, s.t)
+        np.testing.assert_array_equal(ds["position"].values, s.x)
+        np.testing.assert_array_equal(ds["energy_dissipated"].values, s.ledger.dissipated)
+        assert ds.attrs["status"] == "completed"
+
+
+def test_sigterm_during_simulate_leaves_a_valid_file_with_the_steps_so_far(tmp_path):
+    import signal
+    import time
+
+    p = subprocess.Popen([sys.executable, "-m", "phsplit", "simulate", "--out", str(tmp_path), "--no-plot",
+                          "--t-end", "400000", "--h", "0.05", "--save-every", "200", "--linear-flow", "gauss"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    part = tmp_path / "fig2.nc.part"
+    deadline = time.monotonic() + 120
+    while not part.exists():
+        assert p.poll() is None, p.communicate()
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(1.5)
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err
+    assert "interrupted after" in err
+    assert not part.exists()
+    with xr.open_dataset(tmp_path / "fig2.nc") as ds:
+        assert ds.attrs["status"] == "interrupted"
+        n = ds.sizes["time"]
+        assert 1 < n < 400000 / 0.05 / 200 + 1
+        t = ds["time"].values
+        assert np.all(np.diff(t) > 0) and np.isclose(t[1] - t[0], 10.0)
+        assert np.all(np.isfinite(ds["position"].values))
+        assert ds.attrs["steps"] == round(t[-1] / 0.05)
+
+
+def test_passivity_warning_only_when_energy_is_created():
+    import warnings
+
+    v = phsplit.Vessel.paper()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", phsplit.PassivityWarning)
+        phsplit.simulate(v, (0.0, 200.0), 0.5, "sp4", control_start=50.0)  # dissipates in every step
+    with pytest.warns(phsplit.PassivityWarning, match="Prop. 2.5"):
+        phsplit.simulate(v, (0.0, 200.0), 40.0, "sp6", control_start=50.0)

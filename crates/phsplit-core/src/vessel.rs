@@ -803,9 +803,14 @@ mod tests {
         }
 
         #[test]
-        fn s2_ledger_balances_exactly(seed in proptest::array::uniform8(-1.0f64..1.0), h in 0.01f64..5.0) {
+        fn s2_ledger_balances_exactly(seed in proptest::array::uniform8(-1.0f64..1.0), h in 0.01f64..50.0,
+                                      variant in 0usize..4) {
             let v = Vessel::paper();
-            let sys = VesselSystem::new(&v, Some(0.0));
+            // exact, and Gauss with 1, 2, 3 stages
+            let sys = match variant {
+                0 => VesselSystem::new(&v, Some(0.0)),
+                k => VesselSystem::new(&v, Some(0.0)).with_linear_flow(LinearFlow::Gauss, 2 * k),
+            };
             let mut s = random_state(&v, seed);
             s.mu.z = 0.0;
             let h0 = v.energy(&s);

@@ -223,7 +223,7 @@ fn method_info<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>>
 
 /// Integrate; returns a dict of numpy arrays. The GIL is released while integrating.
 #[pyfunction]
-#[pyo3(signature = (vessel, t0, h, n_steps, method, control_start, outer, save_every, ledger, state0, linear_flow="exact"))]
+#[pyo3(signature = (vessel, t0, h, n_steps, method, control_start, outer, save_every, ledger, state0, linear_flow="exact", orthonormalize=false))]
 #[allow(clippy::too_many_arguments)]
 fn integrate<'py>(
     py: Python<'py>,
@@ -238,6 +238,7 @@ fn integrate<'py>(
     ledger: bool,
     state0: PyReadonlyArray1<'_, f64>,
     linear_flow: &str,
+    orthonormalize: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::by_name(method).map_err(to_py)?;
     let linear = match linear_flow {
@@ -266,11 +267,19 @@ fn integrate<'py>(
             )));
         }
     }
-    let y0 = flat_state(&state0)?;
-    if so3::orthogonality_defect(&y0.q) > 1e-9 {
+    let mut y0 = flat_state(&state0)?;
+    if orthonormalize {
+        y0.q = so3::orthonormalize(&y0.q);
+        if !y0.q.iter().all(|v| v.is_finite()) {
+            return Err(InvalidInputError::new_err(
+                "the initial attitude Q cannot be projected to a rotation (it is zero or not finite)",
+            ));
+        }
+    } else if so3::orthogonality_defect(&y0.q) > 1e-9 || y0.q.determinant() < 0.0 {
         return Err(InvalidInputError::new_err(format!(
-            "the initial attitude Q is not a rotation: ‖QᵀQ − I‖ = {:.3e} (allowed ≤ 1e-9)",
-            so3::orthogonality_defect(&y0.q)
+            "the initial attitude Q is not a rotation: ‖QᵀQ − I‖ = {:.3e}, det Q = {:.6} (allowed: ‖QᵀQ − I‖ ≤ 1e-9, det Q = 1); pass orthonormalize=True to project it to the nearest rotation",
+            so3::orthogonality_defect(&y0.q),
+            y0.q.determinant()
         )));
     }
     let opts = Options {
@@ -282,11 +291,22 @@ fn integrate<'py>(
         ledger,
     };
     let v = vessel.inner.clone();
+    // A panic in the core (a bug) reaches Python as a PhsplitError, never an abort.
     let traj = py
         .detach(move || {
-            let sys = VesselSystem::new(&v, control_start).with_linear_flow(linear, order);
-            run(&sys, &method, y0, &opts)
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let sys = VesselSystem::new(&v, control_start).with_linear_flow(linear, order);
+                run(&sys, &method, y0, &opts)
+            }))
         })
+        .map_err(|p| {
+            let msg = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown panic".into());
+            PhsplitError::new_err(format!("internal error in the phsplit core: {msg}"))
+        })?
         .map_err(to_py)?;
     let n = traj.t.len();
     let mut cols: [Vec<f64>; 8] = Default::default();
@@ -427,6 +447,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(method_info, m)?)?;
     m.add_function(wrap_pyfunction!(euler_zyx, m)?)?;
     m.add("METHODS", METHOD_NAMES.to_vec())?;
+    m.add("MAX_STEPS", phsplit_core::integrate::MAX_STEPS)?;
     m.add("PhsplitError", m.py().get_type::<PhsplitError>())?;
     m.add("InvalidInputError", m.py().get_type::<InvalidInputError>())?;
     m.add(

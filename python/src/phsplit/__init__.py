@@ -19,7 +19,7 @@ from ._core import (
     __version__,
 )
 from ._core import method_info as _method_info
-from .simulate import Ledger, Solution, Vessel, simulate
+from .simulate import Ledger, PassivityWarning, Solution, Vessel, simulate
 
 
 def method_info(name: str) -> dict:
@@ -32,6 +32,7 @@ __all__ = [
     "IntegrationError",
     "InvalidInputError",
     "Ledger",
+    "PassivityWarning",
     "PhsplitError",
     "ScenarioParseError",
     "Solution",

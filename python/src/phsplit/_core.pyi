@@ -5,6 +5,7 @@ import numpy as np
 import numpy.typing as npt
 
 METHODS: list[str]
+MAX_STEPS: int
 __version__: str
 
 class PhsplitError(Exception): ...
@@ -48,6 +49,7 @@ def integrate(
     ledger: bool,
     state0: npt.NDArray[np.float64],
     linear_flow: str = ...,
+    orthonormalize: bool = ...,
 ) -> dict[str, Any]: ...
 def method_info(name: str) -> dict[str, Any]: ...
 def euler_zyx(q: list[list[float]]) -> list[float]: ...

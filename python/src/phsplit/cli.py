@@ -28,7 +28,9 @@ def _parser() -> argparse.ArgumentParser:
     s = sub.add_parser(
         "simulate",
         help="run a scenario (default: the paper's Fig. 2) and write NetCDF + PNG",
-        description="Run a scenario and write <out>/<name>.nc (xarray/NetCDF) and <out>/<name>.png.",
+        description="Run a scenario and write <out>/<name>.nc (xarray/NetCDF) and <out>/<name>.png. "
+        "The NetCDF file is built as <name>.nc.part and renamed when closed: Ctrl-C or SIGTERM "
+        "leaves either no file or a valid one with the steps computed so far.",
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -37,6 +39,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--method", help="override the method")
     s.add_argument("--h", type=float, help="override the step size, s")
     s.add_argument("--t-end", type=float, help="override the end time, s")
+    s.add_argument("--save-every", type=int, help="save every k-th step (decimation)")
+    s.add_argument("--linear-flow", choices=["exact", "gauss"], default="exact",
+                   help="flow S2 exactly (matrix exponentials) or by Gauss collocation (faster)")
     s.add_argument("--no-plot", action="store_true", help="skip the PNG")
     sub.add_parser("methods", help="list the integration methods")
     r = sub.add_parser(
@@ -57,7 +62,20 @@ class UsageError(Exception):
     pass
 
 
+def _chunks(n: int, save_every: int, target: int = 100) -> list[int]:
+    """Split n steps into about `target` chunks, each a multiple of save_every (but the last)."""
+    size = max(save_every, -(-n // target))
+    size = -(-size // save_every) * save_every
+    out = []
+    while n > 0:
+        out.append(min(size, n))
+        n -= out[-1]
+    return out
+
+
 def _simulate(args) -> int:
+    import numpy as np
+
     import phsplit
     from . import scenario as scn
     from .plotting import plot_positions, publish, reference_of
@@ -69,6 +87,8 @@ def _simulate(args) -> int:
         sc.h = args.h
     if args.t_end is not None:
         sc.t_span = (sc.t_span[0], args.t_end)
+    if args.save_every is not None:
+        sc.save_every = args.save_every
     out = args.out
     try:
         os.makedirs(out, exist_ok=True)
@@ -76,40 +96,110 @@ def _simulate(args) -> int:
         raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
     if not os.access(out, os.W_OK):
         raise UsageError(f"output folder {out!r} is not writable")
+    # Validate everything (and learn the step count) before any file is touched.
+    t0, t1 = sc.t_span
+    phsplit.simulate(sc.vessel, (t0, t0 + sc.h), sc.h, sc.method, control_start=sc.control_start,
+                     outer=sc.outer, save_every=1, linear_flow=args.linear_flow)
+    n = int(np.floor((t1 - t0) / sc.h * (1 + 1e-12)))
     print(f"phsplit {phsplit.__version__}: {sc.name}: {sc.method} h={sc.h:g} s on "
-          f"[{sc.t_span[0]:g}, {sc.t_span[1]:g}] s, controller from t={sc.control_start}", flush=True)
-    t0 = time.perf_counter()
-    sol = phsplit.simulate(sc.vessel, t_span=sc.t_span, h=sc.h, method=sc.method,
-                           control_start=sc.control_start, outer=sc.outer, save_every=sc.save_every)
-    dt = time.perf_counter() - t0
-    ds = sol.to_xarray()
-    ds.attrs["scenario"] = args.scenario or "paper Fig. 2 (built in)"
+          f"[{t0:g}, {t1:g}] s ({n} steps), controller from t={sc.control_start}", flush=True)
     nc = os.path.join(out, f"{sc.name}.nc")
-    fd, tmp = tempfile.mkstemp(dir=out, prefix=".tmp-", suffix=".nc")
-    os.close(fd)
+    part = nc + ".part"
+    t_start = time.perf_counter()
+    state = sc.vessel.initial_state()
+    t = t0
+    done = 0
+    status = "completed"
+    sols = []
+    nc_file = None
+    from tqdm import tqdm
+
+    bar = tqdm(total=n, unit="step", unit_scale=True, disable=not (sys.stderr.isatty() and n > 20_000), leave=False)
     try:
-        ds.to_netcdf(tmp)
-        publish(tmp, nc)
+        for k in _chunks(n, sc.save_every):
+            sol = phsplit.simulate(sc.vessel, (t, t + k * sc.h), sc.h, sc.method, control_start=sc.control_start,
+                                   outer=sc.outer, save_every=sc.save_every, initial=state,
+                                   linear_flow=args.linear_flow)
+            nc_file = _append(nc_file, part, sol, first=(done == 0), scenario=args.scenario)
+            sols.append(sol)
+            done += sol.steps
+            bar.update(sol.steps)
+            if sol.status != "completed":
+                status = "failed"
+                break
+            state = sol.last_good_state
+            t = float(sol.t[-1])
+    except KeyboardInterrupt:
+        status = "interrupted"
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        bar.close()
+        if nc_file is not None:
+            nc_file.setncattr("status", status)
+            nc_file.setncattr("steps", done)
+            nc_file.close()
+            publish(part, nc)
+        elif os.path.exists(part):
+            os.unlink(part)
+    dt = time.perf_counter() - t_start
+    if status == "interrupted":
+        if sols:
+            print(f"phsplit: interrupted after {done} of {n} steps; {os.path.abspath(nc)} holds them", file=sys.stderr)
+        else:
+            print("phsplit: interrupted before the first steps; no file was written", file=sys.stderr)
+        return 130
+    last = sols[-1]
     files = [nc]
     if not args.no_plot:
         png = os.path.join(out, f"{sc.name}.png")
-        plot_positions(sol, png, reference_of(sc.vessel))
+        plot_positions(_concat(sols), png, reference_of(sc.vessel))
         files.append(png)
-    e = sol.euler[-1]
-    rr = sol.ledger.relative_residual()
-    print(f"{sol.status}: {sol.steps} steps in {dt:.3f} s")
-    print(f"t = {sol.t[-1]:g} s: x = ({sol.x[-1, 0]:.3f}, {sol.x[-1, 1]:.3f}, {sol.x[-1, 2]:.4f}) m, "
+    e = last.euler[-1]
+    rr = max(float(s_.ledger.relative_residual().max()) for s_ in sols)
+    print(f"{status}: {done} steps in {dt:.3f} s")
+    print(f"t = {last.t[-1]:g} s: x = ({last.x[-1, 0]:.3f}, {last.x[-1, 1]:.3f}, {last.x[-1, 2]:.4f}) m, "
           f"roll/pitch/yaw = ({e[0]:.5f}, {e[1]:.5f}, {e[2]:.5f}) rad")
-    print(f"energy H: {sol.energy[0]:.6e} -> {sol.energy[-1]:.6e} J; worst relative ledger residual {rr.max():.2e}")
+    print(f"energy H: {sols[0].energy[0]:.6e} -> {last.energy[-1]:.6e} J; worst relative ledger residual {rr:.2e}")
     for f in files:
         print(f"wrote {os.path.abspath(f)}")
-    if sol.status != "completed":
-        print(f"error: the run failed: {sol.failure}", file=sys.stderr)
+    if status != "completed":
+        print(f"error: the run failed: {last.failure}; the file holds the steps before it", file=sys.stderr)
         return 1
     return 0
+
+
+def _append(nc_file, path: str, sol, first: bool, scenario):
+    """Write a chunk: the first creates the file (time unlimited), the others append their rows
+    after the first (which repeats the previous chunk's last). Synced after every chunk, so the
+    file on disk holds every finished chunk."""
+    import netCDF4
+
+    ds = sol.to_xarray()
+    if first:
+        ds.attrs["scenario"] = scenario or "paper Fig. 2 (built in)"
+        ds.to_netcdf(path, unlimited_dims=["time"])
+        nc_file = netCDF4.Dataset(path, "a")
+    else:
+        n0 = len(nc_file.dimensions["time"])
+        rows = ds.isel(time=slice(1, None))
+        m = rows.sizes["time"]
+        if m:
+            nc_file.variables["time"][n0:n0 + m] = rows["time"].values
+            for name, var in rows.data_vars.items():
+                if var.dims and var.dims[0] == "time":
+                    nc_file.variables[name][n0:n0 + m, ...] = var.values
+    nc_file.sync()
+    return nc_file
+
+
+def _concat(sols):
+    """One Solution-like object of the chunks (for the plot)."""
+    import numpy as np
+    from types import SimpleNamespace
+
+    cat = lambda k: np.concatenate([getattr(s, k) if i == 0 else getattr(s, k)[1:]  # noqa: E731
+                                    for i, s in enumerate(sols)])
+    return SimpleNamespace(t=cat("t"), x=cat("x"), euler=cat("euler"), method=sols[0].method, h=sols[0].h,
+                           control_start=sols[0].control_start)
 
 
 def _reproduce(args) -> int:

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
@@ -11,6 +12,11 @@ import numpy as np
 from . import _core
 
 _OUTER = ("dissipative", "conservative")
+
+
+class PassivityWarning(UserWarning):
+    """A composition with negative sub-steps created energy: its discrete map is passive only
+    under the condition of the paper's Prop. 2.5, which this run does not meet."""
 
 
 class Vessel:
@@ -42,11 +48,14 @@ class Vessel:
         try:
             return cls(_core.Vessel.from_toml_str(text), p)
         except _core.ScenarioParseError as e:
-            raise _core.ScenarioParseError(f"{p}: {e}") from None
+            raise _core.ScenarioParseError(f"{p}: {_suggest(str(e))}") from None
 
     @classmethod
     def from_toml_str(cls, text: str) -> "Vessel":
-        return cls(_core.Vessel.from_toml_str(text), "<string>")
+        try:
+            return cls(_core.Vessel.from_toml_str(text), "<string>")
+        except _core.ScenarioParseError as e:
+            raise _core.ScenarioParseError(_suggest(str(e))) from None
 
     @staticmethod
     def paper_toml() -> str:
@@ -74,6 +83,19 @@ class Vessel:
 
     def __repr__(self) -> str:
         return f"<phsplit.Vessel {self.source or 'custom'}: {self._inner!r}>"
+
+
+def _suggest(message: str) -> str:
+    """Add the nearest valid key to the parser's "unknown field `x`, expected one of ..."."""
+    import difflib
+    import re
+
+    m = re.search(r"unknown field `([^`]*)`, expected (?:one of )?(.*)", message)
+    if not m:
+        return message
+    valid = re.findall(r"`([^`]*)`", m.group(2))
+    near = difflib.get_close_matches(m.group(1), valid, n=1)
+    return message.rstrip() + (f"; did you mean '{near[0]}'?" if near else "")
 
 
 def _vec3(name: str, v: Any) -> list[float]:
@@ -202,6 +224,26 @@ class Solution:
         return ds
 
 
+def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray) -> None:
+    """Prop. 2.5: with negative sub-steps the composition dissipates only if
+    sum(mu_i c_i) >= 0 over the dissipative flow's coefficients, i.e. if sigma_max/sigma_min of
+    H^(1/2) D H^(1/2) is below a bound of the method. Here D acts on the velocities only
+    (sigma_min = 0), so the condition never holds; the ledger tells whether energy was created."""
+    d = raw["dissipated"][1:]
+    scale = abs(e[0]) + np.abs(raw["supplied"]).sum() + np.abs(d[np.isfinite(d)]).sum()
+    bad = ~np.isfinite(d) | (d < -1e-12 * scale)
+    if not bad.any():
+        return
+    i = int(np.argmax(bad)) + 1
+    key = "dissipation_ratio_bound_outer" if outer == "dissipative" else "dissipation_ratio_bound_inner"
+    warnings.warn(PassivityWarning(
+        f"{info['name'].upper()} has negative sub-steps and created energy in {int(bad.sum())} saved "
+        f"interval(s), first ending at t = {raw['t'][i]:g} s ({d[i - 1]:.3e} J dissipated). Its passivity needs "
+        f"the Prop. 2.5 condition sigma_max/sigma_min <= {info[key]:.3g} for H^(1/2) D H^(1/2); this vessel's "
+        "D is only semidefinite (sigma_min = 0), so the condition does not hold. Use a smaller h, or "
+        "'sp2'/'lie', whose positive steps are passive for any h (Prop. 2.2)."), stacklevel=3)
+
+
 def simulate(
     vessel: Vessel,
     t_span: tuple[float, float] = (0.0, 200.0),
@@ -214,6 +256,7 @@ def simulate(
     ledger: bool = True,
     initial: np.ndarray | Mapping[str, Sequence[float]] | None = None,
     linear_flow: str = "exact",
+    orthonormalize: bool = False,
 ) -> Solution:
     """Simulate the vessel with fixed steps ``h`` over ``t_span``.
 
@@ -226,7 +269,9 @@ def simulate(
     state: a flat 27-vector or a mapping with ``euler``, ``position``, ``velocity``,
     ``angular_velocity``. ``linear_flow`` integrates the linear flow S2 exactly (``"exact"``,
     matrix exponentials) or by Gauss collocation of the method's order (``"gauss"``, the
-    diagonal Padé approximant: faster, same order, still passive; paper Remark 2.3).
+    diagonal Padé approximant: faster, same order, still passive; paper Remark 2.3). An initial
+    attitude that is not a rotation is rejected unless ``orthonormalize=True`` asks for its
+    projection to the nearest rotation.
 
     A run whose state becomes non-finite stops there: ``status == "failed"``, ``failure`` says
     where, the arrays hold what was saved before, ``last_good_state`` the last finite state.
@@ -251,6 +296,12 @@ def simulate(
     n = math.floor((t1 - t0) / h * (1 + 1e-12))
     if n < 1:
         raise _core.InvalidInputError(f"h = {h} s is longer than t_span ({t1 - t0} s): no step to take")
+    if n > _core.MAX_STEPS:
+        raise _core.InvalidInputError(
+            f"t_span / h asks for {n:.3e} steps; a run takes at most {_core.MAX_STEPS:.0e} steps "
+            "(split it into several runs, or take a longer h)")
+    if control_start is not None and not math.isfinite(float(control_start)):
+        raise _core.InvalidInputError(f"control_start must be finite (s) or None, got {control_start}")
     if control_start is not None:
         control_start = float(control_start)
     if initial is None:
@@ -262,9 +313,12 @@ def simulate(
     if linear_flow not in ("exact", "gauss"):
         raise _core.InvalidInputError(f"linear_flow must be 'exact' or 'gauss', got {linear_flow!r}")
     raw = _core.integrate(vessel._inner, t0, h, n, method, control_start, outer, int(save_every), bool(ledger), y0,
-                          linear_flow)
+                          linear_flow, bool(orthonormalize))
     e = raw["energy"]
     dH = np.concatenate([[0.0], np.diff(e)])
+    info = _core.method_info(method)
+    if ledger and info["kind"] == "splitting" and not info["all_positive"] and len(e) > 1:
+        _warn_if_energy_created(raw, info, outer, e)
     hull = vessel.to_dict()["vessel"]
     return Solution(
         t=raw["t"], x=raw["x"], euler=raw["euler"], quaternion=raw["quaternion"], Q=raw["Q"],

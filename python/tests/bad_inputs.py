@@ -1,0 +1,127 @@
+"""The catalogue of bad inputs: each entry makes one mistake a user can make, and states the
+exception it must raise and the words its message must contain (the offending field, and what
+is allowed). ``test_bad_inputs.py`` checks every entry; ``scripts/gen_error_catalogue.py`` turns
+the same table into ``docs/errors.md`` with the actual messages."""
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+import phsplit
+
+PAPER = phsplit.Vessel.paper_toml()
+
+
+@dataclass
+class Bad:
+    what: str
+    make: Callable[[], object]
+    error: type
+    must_say: tuple[str, ...]
+
+
+def vessel_with(old: str, new: str) -> Callable[[], object]:
+    assert old in PAPER, old
+    return lambda: phsplit.Vessel.from_toml_str(PAPER.replace(old, new, 1))
+
+
+def sim(**kw) -> Callable[[], object]:
+    return lambda: phsplit.simulate(phsplit.Vessel.paper(), **{"t_span": (0.0, 10.0), "h": 0.5, **kw})
+
+
+def scenario(text: str) -> Callable[[], object]:
+    def run():
+        from phsplit import scenario as scn
+
+        with tempfile.TemporaryDirectory() as d:
+            p = os.path.join(d, "bad.toml")
+            with open(p, "w") as f:
+                f.write(text)
+            return scn.load(p)
+
+    return run
+
+
+def initial_with(index: slice | int, value) -> Callable[[], object]:
+    def run():
+        y = phsplit.Vessel.paper().initial_state()
+        y[index] = value
+        return phsplit.simulate(phsplit.Vessel.paper(), (0.0, 1.0), 0.5, initial=y)
+
+    return run
+
+
+E = phsplit.InvalidInputError
+P = phsplit.ScenarioParseError
+
+CATALOGUE: list[Bad] = [
+    # vessel parameters
+    Bad("negative mass", vessel_with("mass = 6.3622085e6", "mass = -1.0"), E, ("vessel.mass", "> 0", "kg")),
+    Bad("zero mass", vessel_with("mass = 6.3622085e6", "mass = 0.0"), E, ("vessel.mass", "> 0")),
+    Bad("NaN mass", vessel_with("mass = 6.3622085e6", "mass = nan"), E, ("vessel.mass", "finite")),
+    Bad("negative inertia", vessel_with("2.726143e9", "-2.726143e9"), E, ("vessel.inertia[1]", "> 0", "kg m^2")),
+    Bad("inertia with two entries", vessel_with("[2.873071e8, 2.726143e9, 2.90000e9]", "[2.873071e8, 2.726143e9]"),
+        P, ("inertia", "3")),
+    Bad("negative heave damping", vessel_with("1.4566249e6]", "-1.4566249e6]"), E,
+        ("vessel.damping_translational[2]", "≥ 0")),
+    Bad("infinite roll damping", vessel_with("9.329153987e6", "inf"), E, ("vessel.damping_rotational[0]", "finite")),
+    Bad("zero metacentric height GM_T", vessel_with("gm_transverse = 2.1440", "gm_transverse = 0.0"), E,
+        ("vessel.gm_transverse", "> 0", "m")),
+    Bad("negative GM_L", vessel_with("gm_longitudinal = 103.628", "gm_longitudinal = -103.6"), E,
+        ("vessel.gm_longitudinal", "> 0")),
+    Bad("zero gravity", vessel_with("gravity = 9.81", "gravity = 0.0"), E, ("vessel.gravity", "> 0")),
+    Bad("negative water density", vessel_with("water_density = 1.025e3", "water_density = -1.025e3"), E,
+        ("vessel.water_density", "> 0")),
+    Bad("zero water-plane area", vessel_with("waterplane_area = 1.3834e3", "waterplane_area = 0.0"), E,
+        ("vessel.waterplane_area", "> 0", "m^2")),
+    Bad("negative proportional gain", vessel_with("kp_translational = [4e5", "kp_translational = [-4e5"), E,
+        ("control.kp_translational[0]", "≥ 0")),
+    Bad("NaN derivative gain", vessel_with("kd_rotational = [0.0, 0.0, 1e9]", "kd_rotational = [0.0, 0.0, nan]"),
+        E, ("control.kd_rotational[2]", "finite")),
+    Bad("infinite set point", vessel_with("position_reference = [780.0", "position_reference = [inf"), E,
+        ("control.position_reference[0]", "finite")),
+    Bad("NaN initial roll", vessel_with("euler = [0.05", "euler = [nan"), E, ("initial.euler[0]", "finite")),
+    Bad("misspelt key", vessel_with("gravity =", "gravitty ="), P, ("gravitty", "did you mean 'gravity'")),
+    Bad("missing key", vessel_with("gravity = 9.81", ""), P, ("gravity", "missing")),
+    Bad("text where a number belongs", vessel_with("mass = 6.3622085e6", 'mass = "heavy"'), P, ("mass",)),
+    Bad("TOML syntax error", vessel_with("[control]", "[control"), P, ("line", "column")),
+    # simulation arguments
+    Bad("zero step", sim(h=0.0), E, ("h", "> 0")),
+    Bad("negative step", sim(h=-0.5), E, ("h", "> 0")),
+    Bad("NaN step", sim(h=math.nan), E, ("h", "finite")),
+    Bad("infinite step", sim(h=math.inf), E, ("h", "finite")),
+    Bad("reversed time span", sim(t_span=(10.0, 0.0)), E, ("t_span", "t1 > t0")),
+    Bad("NaN in time span", sim(t_span=(0.0, math.nan)), E, ("t_span", "finite")),
+    Bad("time span that is not two numbers", sim(t_span="ten"), E, ("t_span", "two numbers")),
+    Bad("step longer than the span", sim(h=20.0), E, ("h", "longer than t_span")),
+    Bad("too many steps", sim(t_span=(0.0, 1e9), h=1e-3), E, ("steps", "at most")),
+    Bad("unknown method", sim(method="rk45"), E, ("method", "rk45", "sp4", "rk4")),
+    Bad("unknown outer flow", sim(outer="middle"), E, ("outer", "dissipative", "conservative")),
+    Bad("save_every zero", sim(save_every=0), E, ("save_every", ">= 1")),
+    Bad("save_every not an integer", sim(save_every=1.5), E, ("save_every", "integer")),
+    Bad("unknown linear flow", sim(linear_flow="pade"), E, ("linear_flow", "exact", "gauss")),
+    Bad("NaN controller start", sim(control_start=math.nan), E, ("control_start", "finite")),
+    Bad("vessel that is not a Vessel", lambda: phsplit.simulate({"mass": 1.0}), E, ("vessel", "phsplit.Vessel")),
+    # initial state
+    Bad("initial Euler angles with two entries", sim(initial={"euler": [0.0, 0.0]}), E, ("euler", "3 components")),
+    Bad("unknown initial-state field", sim(initial={"speed": [1.0, 0.0, 0.0]}), E, ("speed", "allowed")),
+    Bad("flat initial state of the wrong length", sim(initial=np.zeros(26)), E, ("27", "got 26")),
+    Bad("NaN in the initial state", initial_with(18, math.nan), E, ("initial state", "finite")),
+    Bad("initial attitude that is not a rotation", initial_with(slice(6, 15), 2 * np.eye(3).reshape(-1)), E,
+        ("attitude", "not a rotation", "orthonormalize")),
+    # scenario files
+    Bad("misspelt scenario key", scenario('[simulation]\nmethdo = "sp2"\n'), P,
+        ("methdo", "did you mean 'method'", "[simulation]")),
+    Bad("unknown scenario table", scenario("[simulaton]\nh = 1.0\n"), P, ("simulaton", "did you mean 'simulation'")),
+    Bad("scenario t_span with one entry", scenario("[simulation]\nt_span = [1.0]\n"), P,
+        ("simulation.t_span", "two numbers")),
+    Bad("scenario step as text", scenario('[simulation]\nh = "fast"\n'), P, ("simulation.h", "step size, s")),
+    Bad("scenario vessel file missing", scenario('vessel = "nowhere.toml"\n[simulation]\nh = 1.0\n'), E,
+        ("nowhere.toml", "cannot read")),
+    Bad("scenario TOML syntax error", scenario("[simulation\nh = 1\n"), P, ("line", "column")),
+]
