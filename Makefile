@@ -8,7 +8,7 @@ BIN    := $(VENV)/bin
 OUT    ?= out
 RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
 
-.PHONY: run test test-rust test-python build reproduce bench bench-quick elliptic-refs clean
+.PHONY: run test test-rust test-python build reproduce bench bench-quick fuzz elliptic-refs clean
 
 run: $(VENV)/.built
 	$(BIN)/phsplit simulate --out $(OUT)
@@ -50,6 +50,13 @@ bench: $(VENV)/.built $(VENV)/.bench-deps
 
 bench-quick: $(VENV)/.built $(VENV)/.bench-deps
 	$(BIN)/python benchmarks/work_precision.py --quick --out benchmarks/results-quick
+
+# Fuzz the input parsers for a minute (not part of `make test`; hypothesis covers them there).
+FUZZ_SECONDS ?= 60
+fuzz: $(VENV)/.built
+	$(BIN)/python -m pip install --quiet -r fuzz/requirements.txt
+	mkdir -p fuzz/corpus-run && cp -n fuzz/corpus/* fuzz/corpus-run/ 2>/dev/null || true
+	$(BIN)/python fuzz/fuzz_inputs.py -max_total_time=$(FUZZ_SECONDS) fuzz/corpus-run
 
 # Regenerate the mpmath reference table of the elliptic functions (checked in).
 elliptic-refs: $(VENV)/.deps

@@ -169,8 +169,8 @@ def scipy_runs(ref_: Reference, quick: bool) -> list[dict]:
                     f.arm()
                     try:
                         return solve_ivp(f, (0.0, T), Y0, method=method, rtol=rtol, atol=rtol * scale * 1e-3)
-                    except OverBudget:
-                        return None
+                    except (OverBudget, ValueError, ArithmeticError, RuntimeError, np.linalg.LinAlgError):
+                        return None  # over the time cap, or the solver failed (recorded as error inf)
 
                 sec, sol = timed(run, min_repeats=1, budget=0.0)
                 err = ref_.error(sol.y[:, -1]) if sol is not None and sol.success else math.inf
