@@ -19,6 +19,7 @@ from ._core import (
     __version__,
 )
 from ._core import method_info as _method_info
+from .batch import simulate_many, with_parameters
 from .simulate import Ledger, PassivityWarning, Solution, Vessel, simulate
 
 
@@ -40,4 +41,6 @@ __all__ = [
     "__version__",
     "method_info",
     "simulate",
+    "simulate_many",
+    "with_parameters",
 ]

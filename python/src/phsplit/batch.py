@@ -1,0 +1,427 @@
+"""Many simulations: in-process batches and parameter sweeps on Dask.
+
+* :func:`simulate_many` runs a list of cases on a thread pool. The core releases the GIL, so the
+  cases run in parallel in one process. It returns one ``xarray.Dataset`` with a ``case``
+  dimension and the varied parameters as coordinates.
+* :func:`run_sweep` (CLI: ``phsplit sweep``) expands a grid or a random sample of parameters into
+  cases and runs them on ``dask.distributed``: a ``LocalCluster`` bound to 127.0.0.1 started for
+  the run, or an existing cluster given by address.
+  - Each finished case is written by the client to ``STORE/cases/<id>.nc`` (temporary file, then
+    rename), so a case is stored once, whole, or not at all.
+  - A rerun on the same store computes only the missing cases.
+  - A worker that dies loses only its running tasks, which Dask reschedules.
+  - A case that fails (bad parameters, divergence) is stored with its error and does not stop
+    the others.
+
+A *case* is a mapping of parameter paths to values, applied to a base vessel: ``vessel.mass``,
+``control.kp_rotational[2]``, ``initial.euler[0]``, ... (the sections and keys of a vessel file).
+"""
+from __future__ import annotations
+
+import concurrent.futures as cf
+import hashlib
+import itertools
+import json
+import math
+import os
+import re
+import tempfile
+import time
+from dataclasses import dataclass, field
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from . import _core
+from .simulate import Vessel, simulate
+
+_PATH = re.compile(r"^(vessel|control|initial)\.([a-z_]+)(?:\[([0-2])\])?$")
+
+
+def _toml_text(d: dict) -> str:
+    lines = []
+    for section in ("vessel", "control", "initial"):
+        lines.append(f"[{section}]")
+        for k, v in d[section].items():
+            if isinstance(v, (list, tuple)):
+                lines.append(f"{k} = [{', '.join(repr(float(x)) for x in v)}]")
+            else:
+                lines.append(f"{k} = {float(v)!r}")
+    return "\n".join(lines).replace("nan", "nan").replace("inf", "inf")
+
+
+def _resolve(d: dict, key: str) -> tuple[str, str, int | None]:
+    """Check a parameter path against a vessel's dict: (section, name, index or None)."""
+    m = _PATH.match(key)
+    if not m or m.group(2) not in d[m.group(1)]:
+        valid = sorted(f"{s}.{k}" for s in d for k in d[s])
+        raise _core.InvalidInputError(
+            f"unknown parameter {key!r}; parameters are section.name or section.name[i], one of: {', '.join(valid)}")
+    sec, name, idx = m.group(1), m.group(2), m.group(3)
+    is_vec = isinstance(d[sec][name], (list, tuple))
+    if is_vec and idx is None:
+        raise _core.InvalidInputError(f"parameter {key!r} is a 3-vector: give an index, e.g. {key}[0]")
+    if not is_vec and idx is not None:
+        raise _core.InvalidInputError(f"parameter {sec}.{name} is a scalar: drop the index in {key!r}")
+    return sec, name, None if idx is None else int(idx)
+
+
+def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
+    """``base`` with parameters replaced: keys ``section.name`` or ``section.name[i]``, sections
+    ``vessel``, ``control``, ``initial``. Unknown paths and bad values raise InvalidInputError."""
+    d = base.to_dict()
+    for key, value in params.items():
+        sec, name, idx = _resolve(d, key)
+        if idx is None:
+            d[sec][name] = float(value)
+        else:
+            cur = list(d[sec][name])
+            cur[idx] = float(value)
+            d[sec][name] = cur
+    v = Vessel.from_toml_str(_toml_text(d))
+    v.source = f"{base.source} with {dict(params)}"
+    return v
+
+
+@dataclass
+class Settings:
+    """Simulation settings shared by every case of a batch or sweep."""
+
+    t_span: tuple[float, float] = (0.0, 200.0)
+    h: float = 0.5
+    method: str = "sp2"
+    control_start: float | None = 50.0
+    outer: str = "dissipative"
+    save_every: int = 1
+    linear_flow: str = "exact"
+
+    def run(self, vessel: Vessel):
+        return simulate(vessel, self.t_span, self.h, self.method, self.control_start, outer=self.outer,
+                        save_every=self.save_every, linear_flow=self.linear_flow)
+
+
+def summarize(vessel: Vessel, sol) -> dict[str, Any]:
+    """Per-case summary: final distances to the set point, energy, peak control effort, status."""
+    from . import reference as ref
+
+    c = vessel.to_dict()["control"]
+    xr_, er = np.asarray(c["position_reference"]), np.asarray(c["euler_reference"])
+    params = vessel.to_dict()
+    f_on = ref.Field(params, True)
+    peak_t = peak_r = 0.0
+    if len(sol.t):
+        for i in range(0, len(sol.t), max(1, len(sol.t) // 400)):
+            if sol.control_start is None or sol.t[i] < sol.control_start:
+                continue
+            y = np.concatenate([sol.p[i], sol.m[i], sol.Q[i].reshape(-1, order="F"), sol.mu[i], sol.x[i],
+                                sol.phi_th[i], sol.phi_x[i]])
+            peak_r = max(peak_r, float(np.linalg.norm(f_on.control_torque(y))))
+            v = sol.p[i] / params["vessel"]["mass"]
+            K = f_on.K
+            Q = sol.Q[i]
+            tau_t = -Q.T @ (K["kp_translational"] @ (sol.x[i] - xr_) + K["kd_translational"] @ Q @ v
+                            + K["ki_translational"] @ sol.phi_x[i])
+            peak_t = max(peak_t, float(np.linalg.norm(tau_t)))
+    bound = 100.0 * (sol.energy[0] + max(0.0, float(np.sum(sol.ledger.supplied))))
+    diverged = sol.status != "completed" or not np.all(np.isfinite(sol.energy)) or float(np.max(sol.energy)) > bound
+    return {
+        "position_error_m": float(np.linalg.norm(sol.x[-1] - xr_)),
+        "yaw_error_rad": float(abs(sol.euler[-1, 2] - er[2])),
+        "energy_final_J": float(sol.energy[-1]),
+        "energy_max_J": float(np.max(sol.energy)),
+        "peak_force_N": peak_t,
+        "peak_moment_Nm": peak_r,
+        "diverged": bool(diverged),
+        "status": sol.status,
+    }
+
+
+def _coord_name(key: str) -> str:
+    return key.replace(".", "_").replace("[", "_").replace("]", "")
+
+
+def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = None,
+                  settings: Settings | None = None, max_workers: int | None = None, **kw):
+    """Run every case (a mapping of parameter paths to values) on a thread pool; the core releases
+    the GIL, so they run in parallel. Returns an ``xarray.Dataset`` with dims ``case`` and
+    ``time`` (all cases share the time grid), the varied parameters as coordinates, and the
+    summary of each case. A case whose parameters are invalid gets ``status = "invalid"`` and
+    NaN series; it does not stop the others. Settings may be given as keyword arguments."""
+    import xarray as xr
+
+    base = base or Vessel.paper()
+    settings = settings or Settings(**kw)
+    keys = sorted({k for c in cases for k in c})
+
+    def one(case):
+        try:
+            v = with_parameters(base, case)
+        except (_core.InvalidInputError, _core.ScenarioParseError) as e:
+            return None, {"status": "invalid", "error": str(e)}
+        sol = settings.run(v)
+        return sol, {**summarize(v, sol), "error": sol.failure or ""}
+
+    with cf.ThreadPoolExecutor(max_workers=max_workers or os.cpu_count() or 2) as pool:
+        results = list(pool.map(one, cases))
+    t = next((s.t for s, _ in results if s is not None and s.status == "completed"), None)
+    if t is None:
+        t = next((s.t for s, _ in results if s is not None), np.zeros(1))
+    n, nt = len(cases), len(t)
+
+    def stack(attr, shape):
+        out = np.full((n,) + shape, np.nan)
+        for i, (s, _) in enumerate(results):
+            if s is not None:
+                a = getattr(s, attr)
+                out[i, : len(a)] = a[:nt]
+        return out
+
+    ds = xr.Dataset(
+        {
+            "position": (("case", "time", "axis"), stack("x", (nt, 3)), {"units": "m"}),
+            "euler": (("case", "time", "angle"), stack("euler", (nt, 3)), {"units": "rad"}),
+            "energy": (("case", "time"), stack("energy", (nt,)), {"units": "J"}),
+        },
+        coords={"case": np.arange(n), "time": ("time", t, {"units": "s"}), "axis": ["x", "y", "z"],
+                "angle": ["roll", "pitch", "yaw"]},
+        attrs={"method": settings.method, "step_size_s": settings.h, "phsplit_version": _core.__version__},
+    )
+    for k in keys:
+        ds = ds.assign_coords({_coord_name(k): ("case", np.array([c.get(k, np.nan) for c in cases], float),
+                                                {"parameter": k})})
+    summary_keys = ["position_error_m", "yaw_error_rad", "energy_final_J", "energy_max_J", "peak_force_N",
+                    "peak_moment_Nm"]
+    for k in summary_keys:
+        ds[k] = ("case", np.array([r.get(k, np.nan) for _, r in results], float))
+    ds["diverged"] = ("case", np.array([bool(r.get("diverged", True)) for _, r in results]))
+    ds["status"] = ("case", np.array([r["status"] for _, r in results], dtype=object))
+    ds["error"] = ("case", np.array([r.get("error", "") for _, r in results], dtype=object))
+    return ds
+
+
+# ------------------------------------------------------------------------------------------
+# sweeps on Dask
+
+
+@dataclass
+class Sweep:
+    settings: Settings
+    base: Vessel
+    cases: list[dict[str, float]] = field(default_factory=list)
+    name: str = "sweep"
+
+    def case_id(self, i: int) -> str:
+        digest = hashlib.sha1(json.dumps(self.cases[i], sort_keys=True).encode()).hexdigest()[:8]
+        return f"case_{i:05d}_{digest}"
+
+
+SWEEP_KEYS = {"mode": "'grid' or 'random'", "samples": "number of random cases", "seed": "random seed",
+              "parameters": "table of parameter paths"}
+
+
+def load_sweep(path: str) -> Sweep:
+    """Read a sweep file: a scenario's ``[simulation]`` (and optional vessel) plus ``[sweep]``.
+
+    ``mode = "grid"``: every parameter is a list of values; the cases are their product.
+    ``mode = "random"``: every parameter is ``{low = ., high = .}`` (uniform) or a list (choice);
+    ``samples`` cases drawn with ``seed``."""
+    import difflib
+    import tomllib
+
+    from . import scenario as scn
+
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except FileNotFoundError:
+        raise _core.InvalidInputError(f"sweep file {path!r} does not exist") from None
+    except tomllib.TOMLDecodeError as e:
+        raise _core.ScenarioParseError(f"{path}: TOML syntax error: {e}") from None
+    sw = data.pop("sweep", None)
+    if not isinstance(sw, dict):
+        raise _core.ScenarioParseError(f"{path}: a sweep file needs a [sweep] table with [sweep.parameters]")
+    for k in sw:
+        if k not in SWEEP_KEYS:
+            near = difflib.get_close_matches(k, list(SWEEP_KEYS), n=1)
+            raise _core.ScenarioParseError(f"{path}: unknown key {k!r} in [sweep]"
+                                           + (f"; did you mean {near[0]!r}?" if near else "")
+                                           + f" (allowed: {', '.join(SWEEP_KEYS)})")
+    # the rest is a scenario
+    with tempfile.NamedTemporaryFile("w", suffix=".toml", dir=os.path.dirname(os.path.abspath(path)),
+                                     delete=False) as tmp:
+        tmp.write(_dump_scenario(data))
+    try:
+        sc = scn.load(tmp.name)
+    finally:
+        os.unlink(tmp.name)
+    settings = Settings(t_span=sc.t_span, h=sc.h, method=sc.method, control_start=sc.control_start,
+                        outer=sc.outer, save_every=sc.save_every)
+    params = sw.get("parameters", {})
+    if not isinstance(params, dict) or not params:
+        raise _core.ScenarioParseError(f"{path}: [sweep.parameters] must list at least one parameter")
+    mode = sw.get("mode", "grid")
+    keys = list(params)
+    d0 = sc.vessel.to_dict()
+    for k in keys:
+        _resolve(d0, k)  # the paths are checked now; the values case by case
+    if mode == "grid":
+        for k in keys:
+            if not isinstance(params[k], list) or not params[k]:
+                raise _core.ScenarioParseError(f"{path}: in grid mode, sweep.parameters.{k} must be a list of values")
+        cases = [dict(zip(keys, map(float, combo))) for combo in itertools.product(*(params[k] for k in keys))]
+    elif mode == "random":
+        n = sw.get("samples")
+        if not isinstance(n, int) or n < 1:
+            raise _core.ScenarioParseError(f"{path}: random mode needs sweep.samples, an integer >= 1")
+        rng = np.random.default_rng(sw.get("seed", 0))
+        cases = [{} for _ in range(n)]
+        for k in keys:
+            spec = params[k]
+            if isinstance(spec, dict) and set(spec) == {"low", "high"}:
+                vals = rng.uniform(float(spec["low"]), float(spec["high"]), size=n)
+            elif isinstance(spec, list) and spec:
+                vals = rng.choice(np.asarray(spec, float), size=n)
+            else:
+                raise _core.ScenarioParseError(
+                    f"{path}: sweep.parameters.{k} must be {{low = ..., high = ...}} or a list in random mode")
+            for c, v in zip(cases, vals):
+                c[k] = float(v)
+    else:
+        raise _core.ScenarioParseError(f"{path}: sweep.mode must be 'grid' or 'random', got {mode!r}")
+    return Sweep(settings=settings, base=sc.vessel, cases=cases,
+                 name=os.path.splitext(os.path.basename(path))[0])
+
+
+def _dump_scenario(data: dict) -> str:
+    from .scenario import _toml_value
+
+    out = []
+    for k, v in data.items():
+        if not isinstance(v, dict):
+            out.append(f"{k} = {_toml_value(v)}")
+    for k, v in data.items():
+        if isinstance(v, dict):
+            out.append(f"[{k}]")
+            out += [f"{kk} = {_toml_value(vv)}" for kk, vv in v.items()]
+    return "\n".join(out) + "\n"
+
+
+def _run_case(base_toml: str, settings: Settings, case: dict) -> dict:
+    """Run one case (on a Dask worker). Returns plain data: arrays and the summary, or the error."""
+    base = Vessel.from_toml_str(base_toml)
+    try:
+        v = with_parameters(base, case)
+    except (_core.InvalidInputError, _core.ScenarioParseError) as e:
+        return {"status": "invalid", "error": str(e), "case": case}
+    sol = settings.run(v)
+    ds = sol.to_xarray()
+    return {"status": sol.status, "error": sol.failure or "", "case": case, "summary": summarize(v, sol),
+            "dataset": ds}
+
+
+def _write_case(store: str, cid: str, result: dict) -> None:
+    """Write one case atomically: STORE/cases/<cid>.nc via a temporary file and a rename."""
+    import xarray as xr
+
+    from .plotting import publish
+
+    cases_dir = os.path.join(store, "cases")
+    ds = result.get("dataset")
+    if ds is None:
+        ds = xr.Dataset()
+    ds = ds.copy()
+    ds.attrs.update({"case_id": cid, "case_status": result["status"], "case_error": result.get("error", ""),
+                     "case_parameters": json.dumps(result["case"], sort_keys=True),
+                     "case_summary": json.dumps(result.get("summary", {}), sort_keys=True)})
+    fd, tmp = tempfile.mkstemp(dir=cases_dir, prefix=".tmp-", suffix=".nc")
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp)
+        publish(tmp, os.path.join(cases_dir, f"{cid}.nc"))
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def done_cases(store: str) -> set[str]:
+    d = os.path.join(store, "cases")
+    return {f[:-3] for f in os.listdir(d) if f.endswith(".nc") and not f.startswith(".")} if os.path.isdir(d) else set()
+
+
+def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers: int | None = None,
+              progress: bool = True, retries: int = 3) -> dict[str, Any]:
+    """Run the missing cases of ``sweep`` on Dask and store them; returns counts and the summary
+    table path."""
+    from dask.distributed import Client, LocalCluster, as_completed
+    from tqdm import tqdm
+
+    os.makedirs(os.path.join(store, "cases"), exist_ok=True)
+    for f in os.listdir(os.path.join(store, "cases")):
+        if f.startswith(".tmp-"):
+            os.unlink(os.path.join(store, "cases", f))  # left by a client that was killed mid-write
+    ids = [sweep.case_id(i) for i in range(len(sweep.cases))]
+    have = done_cases(store)
+    todo = [i for i, cid in enumerate(ids) if cid not in have]
+    with open(os.path.join(store, "sweep.json"), "w") as f:
+        json.dump({"name": sweep.name, "settings": sweep.settings.__dict__, "cases": dict(zip(ids, sweep.cases))},
+                  f, indent=1, default=str)
+    cluster = None
+    t0 = time.perf_counter()
+    if todo:
+        if scheduler:
+            client = Client(scheduler, set_as_default=False)
+        else:
+            cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 2, threads_per_worker=1,
+                                   processes=True, host="127.0.0.1", dashboard_address=None)
+            client = Client(cluster, set_as_default=False)
+        try:
+            base_toml = _toml_text(sweep.base.to_dict())
+            futures = {client.submit(_run_case, base_toml, sweep.settings, sweep.cases[i], key=ids[i],
+                                     retries=retries, pure=False): ids[i] for i in todo}
+            with tqdm(total=len(ids), initial=len(ids) - len(todo), unit="case", disable=not progress) as bar:
+                for fut in as_completed(futures, loop=client.loop):
+                    cid = futures[fut]
+                    try:
+                        result = fut.result()
+                    except Exception as e:  # noqa: BLE001 - a case's crash is recorded, not fatal
+                        result = {"status": "error", "error": f"{type(e).__name__}: {e}",
+                                  "case": sweep.cases[ids.index(cid)]}
+                    _write_case(store, cid, result)
+                    bar.update(1)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    elapsed = time.perf_counter() - t0
+    summary = write_summary(store, ids)
+    return {"cases": len(ids), "computed": len(todo), "reused": len(ids) - len(todo), "seconds": elapsed,
+            "summary": summary}
+
+
+def write_summary(store: str, ids: list[str]) -> str:
+    """One row per case: parameters, summary, status and error; as CSV and NetCDF."""
+    import csv
+
+    import xarray as xr
+
+    rows = []
+    for cid in ids:
+        with xr.open_dataset(os.path.join(store, "cases", f"{cid}.nc")) as ds:
+            a = ds.attrs
+            rows.append({"case_id": cid, **json.loads(a["case_parameters"]), **json.loads(a["case_summary"]),
+                         "status": a["case_status"], "error": a["case_error"]})
+    cols = list(dict.fromkeys(k for r in rows for k in r))
+    path = os.path.join(store, "summary.csv")
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=cols)
+        w.writeheader()
+        w.writerows(rows)
+    data = {}
+    for c in cols:
+        vals = [r.get(c, math.nan) for r in rows]
+        if all(isinstance(v, (int, float, bool)) for v in vals):
+            data[_coord_name(c)] = ("case", np.asarray(vals, float))
+        else:
+            data[_coord_name(c)] = ("case", np.asarray([str(v) for v in vals], dtype=object))
+    xr.Dataset(data).to_netcdf(os.path.join(store, "summary.nc"))
+    return path

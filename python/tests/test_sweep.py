@@ -1,0 +1,116 @@
+"""Batches and sweeps: in-process threads, and dask.distributed LocalClusters with worker
+processes on loopback (resume, a failing case, a worker killed mid-sweep)."""
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import phsplit
+from phsplit.batch import Settings, Sweep, done_cases, load_sweep, run_sweep
+from phsplit.cli import main
+
+SHORT = Settings(t_span=(0.0, 100.0), h=0.5, method="sp2", control_start=0.0)
+
+
+def test_simulate_many_labels_cases_and_keeps_going_past_a_bad_one():
+    cases = [{"control.kp_rotational[2]": k, "vessel.mass": m} for k in (5e7, 1e8) for m in (6e6, 7e6)]
+    cases.append({"vessel.mass": -1.0})
+    ds = phsplit.simulate_many(cases, settings=SHORT)
+    assert ds.sizes["case"] == 5 and ds.sizes["time"] == 201
+    np.testing.assert_array_equal(ds["control_kp_rotational_2"].values[:4], [5e7, 5e7, 1e8, 1e8])
+    assert list(ds["status"].values) == ["completed"] * 4 + ["invalid"]
+    assert "vessel.mass must be > 0" in ds["error"].values[4]
+    assert np.isnan(ds["position"].values[4]).all()
+    # each case equals a direct simulation of the same vessel
+    v = phsplit.with_parameters(phsplit.Vessel.paper(), cases[2])
+    direct = phsplit.simulate(v, (0.0, 100.0), 0.5, "sp2", control_start=0.0)
+    np.testing.assert_array_equal(ds["position"].values[2], direct.x)
+    assert (ds["position_error_m"].values[:4] < 60).all() and ds["peak_moment_Nm"].values[0] > 0
+
+
+def test_with_parameters_rejects_unknown_paths():
+    with pytest.raises(phsplit.InvalidInputError, match="unknown parameter 'vessel.mas'"):
+        phsplit.with_parameters(phsplit.Vessel.paper(), {"vessel.mas": 1.0})
+    with pytest.raises(phsplit.InvalidInputError, match="3-vector"):
+        phsplit.with_parameters(phsplit.Vessel.paper(), {"vessel.inertia": 1.0})
+
+
+SWEEP_TOML = """
+[simulation]
+t_span = [0.0, {t_end}]
+h = {h}
+method = "sp2"
+control_start = 0.0
+save_every = 10
+
+[sweep]
+mode = "grid"
+
+[sweep.parameters]
+"control.kp_translational[0]" = [2e5, 4e5, 8e5]
+"vessel.mass" = [-1.0, 6e6, 7e6]
+"""
+
+
+def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
+    f = tmp_path / "grid.toml"
+    f.write_text(SWEEP_TOML.format(t_end=50.0, h=0.5))
+    store = tmp_path / "grid.store"
+    assert main(["sweep", str(f), "--out", str(store), "--workers", "2", "--no-progress"]) == 0
+    sw = load_sweep(str(f))
+    ids = {sw.case_id(i) for i in range(9)}
+    assert done_cases(str(store)) == ids
+    with xr.open_dataset(store / "summary.nc") as s:
+        status = list(s["status"].values)
+    assert status.count("invalid") == 3 and status.count("completed") == 6
+    # a second run reuses everything
+    t0 = time.monotonic()
+    res = run_sweep(sw, str(store), n_workers=2, progress=False)
+    assert res["computed"] == 0 and res["reused"] == 9 and time.monotonic() - t0 < 20
+    # a lost case is recomputed, and only that one
+    os.unlink(store / "cases" / f"{sw.case_id(4)}.nc")
+    res = run_sweep(sw, str(store), n_workers=2, progress=False)
+    assert res["computed"] == 1 and done_cases(str(store)) == ids
+
+
+def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
+    from dask.distributed import Client, LocalCluster
+
+    f = tmp_path / "grid.toml"
+    f.write_text(SWEEP_TOML.format(t_end=600.0, h=0.05).replace('[-1.0, 6e6, 7e6]', '[5e6, 6e6, 7e6, 8e6]'))
+    sw = load_sweep(str(f))
+    store = tmp_path / "store"
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address=None)
+    killed = []
+
+    def killer():
+        with Client(cluster.scheduler_address, set_as_default=False) as c:
+            deadline = time.monotonic() + 120
+            while len(done_cases(str(store))) < 2 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            pids = c.run(os.getpid)
+            pid = sorted(pids.values())[0]
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+
+    try:
+        th = threading.Thread(target=killer)
+        th.start()
+        res = run_sweep(sw, str(store), scheduler=cluster.scheduler_address, progress=False)
+        th.join()
+    finally:
+        cluster.close()
+    assert killed, "no worker was killed"
+    assert res["cases"] == 12
+    ids = [sw.case_id(i) for i in range(12)]
+    files = sorted(os.listdir(store / "cases"))
+    assert files == sorted(f"{i}.nc" for i in ids)  # every case exactly once, no temporary files
+    with xr.open_dataset(store / "summary.nc") as s:
+        assert list(s["status"].values) == ["completed"] * 12
