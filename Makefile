@@ -47,6 +47,7 @@ $(VENV)/.bench-deps: $(VENV)/.deps benchmarks/requirements.txt
 bench: $(VENV)/.built $(VENV)/.bench-deps
 	cargo bench -p phsplit-core --bench flows
 	$(BIN)/python benchmarks/work_precision.py
+	$(BIN)/python benchmarks/sweep_throughput.py
 
 bench-quick: $(VENV)/.built $(VENV)/.bench-deps
 	$(BIN)/python benchmarks/work_precision.py --quick --out benchmarks/results-quick
