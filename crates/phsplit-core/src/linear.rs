@@ -195,6 +195,17 @@ mod tests {
 
     type M3 = SMatrix<f64, 3, 3>;
 
+    /// Weight of node `i` of composite Simpson's rule on `n` (even) intervals, times 3/h.
+    fn simpson_weight(i: usize, n: usize) -> f64 {
+        if i == 0 || i == n {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        }
+    }
+
     /// y' = −2 y + 3 (augmented as 2×2... padded to 3 with a second decoupled state y2' = y1).
     fn example() -> M3 {
         M3::new(-2.0, 0.0, 3.0, 1.0, -0.5, 0.0, 0.0, 0.0, 0.0)
@@ -253,13 +264,7 @@ mod tests {
         let step = flow(&a, h / n as f64);
         let (mut zz, mut acc) = (z0, 0.0);
         for i in 0..=n {
-            let w = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
+            let w = simpson_weight(i, n);
             acc += w * zz.dot(&(m * zz));
             zz = step * zz;
         }
@@ -309,13 +314,7 @@ mod tests {
             for i in 0..=n {
                 let t = h * i as f64 / n as f64;
                 let z = flow(&a, t) * z0;
-                let w = if i == 0 || i == n {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
+                let w = simpson_weight(i, n);
                 s += w * z.dot(&(m * z));
             }
             s * h / (3.0 * n as f64)
