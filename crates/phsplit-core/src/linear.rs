@@ -186,6 +186,116 @@ pub mod gauss {
         }
         Some((z1, ys, b))
     }
+
+    /// Gauss collocation with `s` stages for an augmented 10×10 system with the block
+    /// structure of the vessel's flow S2, `z = (u, v, w, 1)` in 3-blocks:
+    /// `u' = A_uu u + A_uv v + A_uw w + c_u`, `v' = A_vu u`, `w' = A_wv v + c_w`
+    /// (checked: the other entries must be zero). The stages of `v` and `w` are eliminated in
+    /// closed form, `V = 1⊗v0 + h(𝒜⊗A_vu)U`, `W = 1⊗w0 + h(𝒜1)⊗c_w + h(𝒜⊗A_wv)V`, which leaves
+    /// one `3s × 3s` system for the stages `U`, with blocks
+    /// `δ_ij I − h a_ij A_uu − h² (𝒜²)_ij A_uv A_vu − h³ (𝒜³)_ij A_uw A_wv A_vu`.
+    /// Returns the update, the stages and the weights (equal to [`stages`] to round-off), or
+    /// `None` if the structure does not hold or the system is singular.
+    pub fn structured(
+        a: &SMatrix<f64, 10, 10>,
+        z0: &SVector<f64, 10>,
+        h: f64,
+        s: usize,
+    ) -> Option<(SVector<f64, 10>, [SVector<f64, 10>; 3], [f64; 3])> {
+        use nalgebra::{Matrix3, Vector3};
+        let blk = |r: usize, c: usize| -> Matrix3<f64> { a.fixed_view::<3, 3>(r, c).into_owned() };
+        let col = |r: usize| -> Vector3<f64> { a.fixed_view::<3, 1>(r, 9).into_owned() };
+        let zero3 = |m: Matrix3<f64>| m.iter().all(|v| *v == 0.0);
+        if !(1..=3).contains(&s)
+            || !(zero3(blk(3, 3)) && zero3(blk(3, 6)) && col(3).iter().all(|v| *v == 0.0))
+            || !(zero3(blk(6, 0)) && zero3(blk(6, 6)))
+            || a.row(9).iter().any(|v| *v != 0.0)
+        {
+            return None;
+        }
+        let (auu, auv, auw, cu) = (blk(0, 0), blk(0, 3), blk(0, 6), col(0));
+        let avu = blk(3, 0);
+        let (awv, cw) = (blk(6, 3), col(6));
+        let (ta, tb) = tableau(s);
+        let mut am = Matrix3::<f64>::zeros(); // the Gauss matrix in the leading s×s corner
+        let mut b = [0.0; 3];
+        for i in 0..s {
+            b[i] = tb[i];
+            for j in 0..s {
+                am[(i, j)] = ta[i][j];
+            }
+        }
+        let am2 = am * am;
+        let am3 = am2 * am;
+        let alpha = am * Vector3::new(1.0, 1.0, 1.0); // the nodes c_i (zero beyond s)
+        let alpha2 = am * alpha;
+        let p2 = auv * avu;
+        let p3 = auw * awv * avu;
+        let one = z0[9];
+        let u0: Vector3<f64> = z0.fixed_rows::<3>(0).into();
+        let v0: Vector3<f64> = z0.fixed_rows::<3>(3).into();
+        let w0: Vector3<f64> = z0.fixed_rows::<3>(6).into();
+        let g1 = (cu * one + auv * v0 + auw * w0) * h;
+        let g2 = auw * (cw * one + awv * v0) * (h * h);
+        let block = |i: usize, j: usize| -> Matrix3<f64> {
+            let d = if i == j {
+                Matrix3::identity()
+            } else {
+                Matrix3::zeros()
+            };
+            d - auu * (h * am[(i, j)]) - p2 * (h * h * am2[(i, j)]) - p3 * (h * h * h * am3[(i, j)])
+        };
+        let rhs_i = |i: usize| u0 + g1 * alpha[i] + g2 * alpha2[i];
+        let mut ust = [Vector3::zeros(); 3];
+        if s == 1 {
+            ust[0] = block(0, 0).lu().solve(&rhs_i(0))?;
+        } else {
+            // s = 2, 3: one 9×9 system, padded with the identity beyond 3s.
+            let mut m = SMatrix::<f64, 9, 9>::identity();
+            let mut rhs = SVector::<f64, 9>::zeros();
+            for i in 0..s {
+                for j in 0..s {
+                    m.fixed_view_mut::<3, 3>(3 * i, 3 * j)
+                        .copy_from(&block(i, j));
+                }
+                rhs.fixed_rows_mut::<3>(3 * i).copy_from(&rhs_i(i));
+            }
+            let x = m.lu().solve(&rhs)?;
+            for (i, u) in ust.iter_mut().enumerate().take(s) {
+                *u = x.fixed_rows::<3>(3 * i).into_owned();
+            }
+        }
+        let mut vst = [Vector3::zeros(); 3];
+        let mut wst = [Vector3::zeros(); 3];
+        for i in 0..s {
+            vst[i] = (0..s).fold(v0, |acc, j| acc + avu * ust[j] * (h * am[(i, j)]));
+        }
+        for i in 0..s {
+            wst[i] = (0..s).fold(w0 + cw * (one * h * alpha[i]), |acc, j| {
+                acc + awv * vst[j] * (h * am[(i, j)])
+            });
+        }
+        let (mut u1, mut v1, mut w1) = (u0, v0, w0);
+        for i in 0..s {
+            u1 += (auu * ust[i] + auv * vst[i] + auw * wst[i] + cu * one) * (h * b[i]);
+            v1 += avu * ust[i] * (h * b[i]);
+            w1 += (awv * vst[i] + cw * one) * (h * b[i]);
+        }
+        let pack = |u: &Vector3<f64>, v: &Vector3<f64>, w: &Vector3<f64>| {
+            let mut z = SVector::<f64, 10>::zeros();
+            z.fixed_rows_mut::<3>(0).copy_from(u);
+            z.fixed_rows_mut::<3>(3).copy_from(v);
+            z.fixed_rows_mut::<3>(6).copy_from(w);
+            z[9] = one;
+            z
+        };
+        let stages = [
+            pack(&ust[0], &vst[0], &wst[0]),
+            pack(&ust[1], &vst[1], &wst[1]),
+            pack(&ust[2], &vst[2], &wst[2]),
+        ];
+        Some((pack(&u1, &v1, &w1), stages, b))
+    }
 }
 
 #[cfg(test)]
@@ -296,6 +406,50 @@ mod tests {
                 "s={s}: slope {slope}, {errs:?}"
             );
         }
+    }
+
+    #[test]
+    fn structured_gauss_equals_the_dense_stage_solve() {
+        // A matrix with the vessel's S2 block structure.
+        let mut a = SMatrix::<f64, 10, 10>::zeros();
+        for i in 0..3 {
+            for j in 0..3 {
+                a[(i, j)] = if i == j {
+                    -0.4 - 0.1 * i as f64
+                } else {
+                    0.05 * (i as f64 - j as f64)
+                };
+                a[(i, 3 + j)] = if i == j { -1.5 } else { 0.1 };
+                a[(i, 6 + j)] = if i == j { -0.2 } else { 0.0 };
+                a[(3 + i, j)] = if i == j { 1.0 } else { 0.02 };
+                a[(6 + i, 3 + j)] = if i == j { 1.0 } else { 0.0 };
+            }
+            a[(i, 9)] = 0.3 * i as f64;
+            a[(6 + i, 9)] = -0.1;
+        }
+        let z0 =
+            SVector::<f64, 10>::from_fn(|i, _| if i == 9 { 1.0 } else { (i as f64 * 0.7).sin() });
+        for h in [0.1, 1.0, 7.0] {
+            let check = |z: SVector<f64, 10>, ys: &[SVector<f64, 10>], s: usize| {
+                let (zd, yd, _) = gauss::stages(&a, &z0, h, s).unwrap();
+                assert!(
+                    (z - zd).norm() < 1e-13 * zd.norm(),
+                    "s={s} h={h}: {}",
+                    (z - zd).norm()
+                );
+                for (y, y2) in ys.iter().zip(&yd) {
+                    assert!((y - y2).norm() < 1e-13 * y2.norm());
+                }
+            };
+            for st in 1..=3 {
+                let (z, ys, _) = gauss::structured(&a, &z0, h, st).unwrap();
+                check(z, &ys[..st], st);
+            }
+        }
+        // Not the structure: refused.
+        let mut b = a;
+        b[(4, 4)] = 1.0;
+        assert!(gauss::structured(&b, &z0, 0.5, 1).is_none());
     }
 
     #[test]

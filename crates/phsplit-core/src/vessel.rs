@@ -535,7 +535,7 @@ impl<'a> VesselSystem<'a> {
     /// The two augmented affine systems of flow S2 at the frozen attitude `Q0` (paper eq. 41):
     /// translation in `z = (p, x − x_ref, phi_x, 1)`, rotation in `z = (m, mu, phi_th, 1)`, with the
     /// quadratic forms of supplied and dissipated power in the same variables.
-    fn s2_systems(&self, q0: &Matrix3<f64>, on: bool) -> [S2Block; 2] {
+    fn s2_systems(&self, q0: &Matrix3<f64>, on: bool, ledger: bool) -> [S2Block; 2] {
         let vsl = self.vessel;
         let f = self.frozen(q0);
         let [kp_t, kd_t, ki_t, kp_r, kd_r, ki_r] = self.gains(on);
@@ -559,14 +559,17 @@ impl<'a> VesselSystem<'a> {
         if on {
             at.fixed_view_mut::<3, 3>(6, 3).copy_from(&i3);
         }
+        // The ledger's quadratic forms, built only when asked for.
         let mut dis_t = SMatrix::<f64, 10, 10>::zeros();
-        dis_t
-            .fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&(d_t / (mv * mv)));
-        // v·tau_PI = (p/mv)ᵀ(−Qᵀ Kp e − Qᵀ Ki phi_x), symmetrised.
         let mut sup_t = SMatrix::<f64, 10, 10>::zeros();
-        put_sym(&mut sup_t, 0, 3, &(-qt * kp_t / mv));
-        put_sym(&mut sup_t, 0, 6, &(-qt * ki_t / mv));
+        if ledger {
+            dis_t
+                .fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(d_t / (mv * mv)));
+            // v·tau_PI = (p/mv)ᵀ(−Qᵀ Kp e − Qᵀ Ki phi_x), symmetrised.
+            put_sym(&mut sup_t, 0, 3, &(-qt * kp_t / mv));
+            put_sym(&mut sup_t, 0, 6, &(-qt * ki_t / mv));
+        }
         // Rotation.
         let tinv = Matrix3::from_diagonal(&vsl.inertia().map(|v| 1.0 / v));
         let wm = f.w_mat;
@@ -586,12 +589,14 @@ impl<'a> VesselSystem<'a> {
             ar.fixed_view_mut::<3, 1>(6, 9).copy_from(&f.theta_err);
         }
         let mut dis_r = SMatrix::<f64, 10, 10>::zeros();
-        dis_r
-            .fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&(tinv * d_r * tinv));
         let mut sup_r = SMatrix::<f64, 10, 10>::zeros();
-        put_sym(&mut sup_r, 0, 6, &(-tinv * wt * ki_r));
-        put_sym_col(&mut sup_r, 0, 9, &(-tinv * wt * kp_r * f.theta_err));
+        if ledger {
+            dis_r
+                .fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(tinv * d_r * tinv));
+            put_sym(&mut sup_r, 0, 6, &(-tinv * wt * ki_r));
+            put_sym_col(&mut sup_r, 0, 9, &(-tinv * wt * kp_r * f.theta_err));
+        }
         let gmax = vsl.g_diag().max();
         let scale_t = SVector::<f64, 10>::from_fn(|i, _| if i < 3 { mv } else { 1.0 });
         let scale_r = SVector::<f64, 10>::from_fn(|i, _| match i {
@@ -619,7 +624,7 @@ impl<'a> VesselSystem<'a> {
     /// (or Gauss collocation, see [`LinearFlow`]). With `ledger`, also the supplied and
     /// dissipated energy over the sub-step, exactly (Van Loan Gramian, or Gauss quadrature).
     pub fn flow_s2(&self, s: &mut VesselState, h: f64, on: bool, ledger: bool) -> Power {
-        let [bt, br] = self.s2_systems(&s.q, on);
+        let [bt, br] = self.s2_systems(&s.q, on, ledger);
         let mut zt = SVector::<f64, 10>::zeros();
         zt.fixed_rows_mut::<3>(0).copy_from(&s.p);
         let xr = Vector3::from(self.vessel.control.position_reference);
@@ -694,9 +699,24 @@ impl S2Block {
                     linear::trace_product(&self.balanced_form(&self.dissipated), &gram);
                 Some(f * zb)
             }
-            (LinearFlow::Gauss, false) => linear::gauss::step(&a, &zb, h, stages),
-            (LinearFlow::Gauss, true) => {
-                linear::gauss::stages(&a, &zb, h, stages).map(|(z1, ys, b)| {
+            (LinearFlow::Gauss, _) => match linear::gauss::structured(&a, &zb, h, stages) {
+                // The S2 blocks have the structure the elimination needs: one 3s×3s solve.
+                Some((z1, ys, b)) => {
+                    if ledger {
+                        let (ms, md) = (
+                            self.balanced_form(&self.supplied),
+                            self.balanced_form(&self.dissipated),
+                        );
+                        for (y, bi) in ys.iter().zip(b).take(stages) {
+                            work.supplied += h * bi * y.dot(&(ms * y));
+                            work.dissipated += h * bi * y.dot(&(md * y));
+                        }
+                    }
+                    Some(z1)
+                }
+                // A singular reduced system: fall back to the dense collocation.
+                None if !ledger => linear::gauss::step(&a, &zb, h, stages),
+                None => linear::gauss::stages(&a, &zb, h, stages).map(|(z1, ys, b)| {
                     let (ms, md) = (
                         self.balanced_form(&self.supplied),
                         self.balanced_form(&self.dissipated),
@@ -706,8 +726,8 @@ impl S2Block {
                         work.dissipated += h * bi * y.dot(&(md * y));
                     }
                     z1
-                })
-            }
+                }),
+            },
         };
         match zb1 {
             Some(v) => (v.component_mul(sc), work),
