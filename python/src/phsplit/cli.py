@@ -79,9 +79,10 @@ class UsageError(Exception):
     pass
 
 
-def _chunks(n: int, save_every: int, target: int = 100) -> list[int]:
-    """Split n steps into about `target` chunks, each a multiple of save_every (but the last)."""
-    size = max(save_every, -(-n // target))
+def _chunks(n: int, save_every: int, target: int = 100, min_steps: int = 20_000) -> list[int]:
+    """Split n steps into at most about `target` chunks of at least `min_steps` steps (so a short
+    run is one call), each a multiple of save_every (but the last)."""
+    size = max(save_every, -(-n // target), min_steps)
     size = -(-size // save_every) * save_every
     out = []
     while n > 0:
@@ -172,7 +173,7 @@ def _simulate(args) -> int:
         files.append(png)
     e = last.euler[-1]
     rr = max(float(s_.ledger.relative_residual().max()) for s_ in sols)
-    print(f"{status}: {done} steps in {dt:.3f} s")
+    print(f"{status}: {done} steps in {dt:.3f} s (integration and writing)")
     print(f"t = {last.t[-1]:g} s: x = ({last.x[-1, 0]:.3f}, {last.x[-1, 1]:.3f}, {last.x[-1, 2]:.4f}) m, "
           f"roll/pitch/yaw = ({e[0]:.5f}, {e[1]:.5f}, {e[2]:.5f}) rad")
     print(f"energy H: {sols[0].energy[0]:.6e} -> {last.energy[-1]:.6e} J; worst relative ledger residual {rr:.2e}")
