@@ -97,26 +97,27 @@ pub fn trace_product(m: &SMatrix<f64, 10, 10>, z: &SMatrix<f64, 10, 10>) -> f64 
 pub mod gauss {
     use super::*;
 
-    /// Butcher coefficients `(A, b)` of the `s`-stage Gauss method.
-    pub fn tableau(s: usize) -> (Vec<Vec<f64>>, Vec<f64>) {
+    /// Butcher coefficients `(A, b)` of the `s`-stage Gauss method, in the leading `s × s`
+    /// corner of fixed-size arrays (no allocation: this is called once per sub-step).
+    pub fn tableau(s: usize) -> ([[f64; 3]; 3], [f64; 3]) {
         match s {
-            1 => (vec![vec![0.5]], vec![1.0]),
+            1 => ([[0.5, 0.0, 0.0], [0.0; 3], [0.0; 3]], [1.0, 0.0, 0.0]),
             2 => {
                 let r = 3f64.sqrt() / 6.0;
                 (
-                    vec![vec![0.25, 0.25 - r], vec![0.25 + r, 0.25]],
-                    vec![0.5, 0.5],
+                    [[0.25, 0.25 - r, 0.0], [0.25 + r, 0.25, 0.0], [0.0; 3]],
+                    [0.5, 0.5, 0.0],
                 )
             }
             3 => {
                 let r = 15f64.sqrt();
                 (
-                    vec![
-                        vec![5.0 / 36.0, 2.0 / 9.0 - r / 15.0, 5.0 / 36.0 - r / 30.0],
-                        vec![5.0 / 36.0 + r / 24.0, 2.0 / 9.0, 5.0 / 36.0 - r / 24.0],
-                        vec![5.0 / 36.0 + r / 30.0, 2.0 / 9.0 + r / 15.0, 5.0 / 36.0],
+                    [
+                        [5.0 / 36.0, 2.0 / 9.0 - r / 15.0, 5.0 / 36.0 - r / 30.0],
+                        [5.0 / 36.0 + r / 24.0, 2.0 / 9.0, 5.0 / 36.0 - r / 24.0],
+                        [5.0 / 36.0 + r / 30.0, 2.0 / 9.0 + r / 15.0, 5.0 / 36.0],
                     ],
-                    vec![5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0],
+                    [5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0],
                 )
             }
             _ => panic!("Gauss collocation is provided with 1, 2 or 3 stages, not {s}"),
@@ -165,6 +166,7 @@ pub mod gauss {
         s: usize,
     ) -> Option<(SVector<f64, 10>, Vec<SVector<f64, 10>>, Vec<f64>)> {
         let (a, b) = tableau(s);
+        let b = b[..s].to_vec();
         let n = 10 * s;
         let mut m = DMatrix::<f64>::identity(n, n);
         let mut rhs = DVector::<f64>::zeros(n);
@@ -185,6 +187,28 @@ pub mod gauss {
             z1 += abar * ys[i] * (h * b[i]);
         }
         Some((z1, ys, b))
+    }
+
+    /// `M x = r` for a 3×3 `M` by the adjugate (Cramer's rule); `None` if `M` is singular to
+    /// working precision.
+    fn solve3(
+        m: &nalgebra::Matrix3<f64>,
+        r: &nalgebra::Vector3<f64>,
+    ) -> Option<nalgebra::Vector3<f64>> {
+        let (c0, c1, c2) = (m.column(0), m.column(1), m.column(2));
+        let x01 = c0.cross(&c1);
+        let det = x01.dot(&c2);
+        let scale = c0.norm() * c1.norm() * c2.norm();
+        if !(det.abs() > 1e-14 * scale) {
+            return None;
+        }
+        let inv = 1.0 / det;
+        // Rows of M⁻¹ are the cross products of pairs of columns over det.
+        Some(nalgebra::Vector3::new(
+            c1.cross(&c2).dot(r) * inv,
+            c2.cross(&c0).dot(r) * inv,
+            x01.dot(r) * inv,
+        ))
     }
 
     /// Gauss collocation with `s` stages for an augmented 10×10 system with the block
@@ -248,7 +272,7 @@ pub mod gauss {
         let rhs_i = |i: usize| u0 + g1 * alpha[i] + g2 * alpha2[i];
         let mut ust = [Vector3::zeros(); 3];
         if s == 1 {
-            ust[0] = block(0, 0).lu().solve(&rhs_i(0))?;
+            ust[0] = solve3(&block(0, 0), &rhs_i(0))?;
         } else {
             // s = 2, 3: one 9×9 system, padded with the identity beyond 3s.
             let mut m = SMatrix::<f64, 9, 9>::identity();
