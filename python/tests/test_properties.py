@@ -70,9 +70,8 @@ FIELDS = ["mass", "gm_transverse", "gm_longitudinal", "gravity", "water_density"
 @settings(max_examples=40, deadline=None)
 @given(field=st.sampled_from(FIELDS), value=st.sampled_from([0.0, -1.0, -1e9, math.nan, math.inf, -math.inf]))
 def test_bad_parameter_values_name_the_field(field, value):
-    lines = [ln if not ln.startswith(field + " ") else f"{field} = {value!r}".replace("nan", "nan")
-             for ln in PAPER.splitlines()]
-    text = "\n".join(lines).replace("= inf", "= inf").replace("= -inf", "= -inf")
+    lines = [ln if not ln.startswith(field + " ") else f"{field} = {value!r}" for ln in PAPER.splitlines()]
+    text = "\n".join(lines)
     try:
         phsplit.Vessel.from_toml_str(text)
     except phsplit.InvalidInputError as e:

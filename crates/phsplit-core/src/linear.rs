@@ -10,8 +10,9 @@
 //! exponential (C. F. Van Loan, *Computing integrals involving the matrix exponential*, IEEE
 //! TAC 23 (1978) 395–404) gives it exactly: for `C = [[−Āᵀ, M], [0, Ā]]`,
 //! `exp(C h) = [[F₁₁, F₁₂], [0, F₂₂]]` with `F₂₂ = exp(Ā h)` and
-//! `∫₀^h exp(Āᵀs) M exp(Ā s) ds = F₂₂ᵀ F₁₂`. Several forms share one exponential of
-//! `[[−Āᵀ, 0, M₁], [0, −Āᵀ, M₂], [0, 0, Ā]]`, whose top-right blocks are the `F₁₂` of each.
+//! `∫₀^h exp(Āᵀs) M exp(Ā s) ds = F₂₂ᵀ F₁₂`. The ledger uses the equivalent state Gramian
+//! ([`flow_and_gramian`]), one 20×20 exponential for any number of forms; the form-by-form
+//! version is kept in the tests as its cross-check.
 
 use nalgebra::{Const, DMatrix, DVector, DimMin, SMatrix, SVector};
 
@@ -21,27 +22,6 @@ where
     Const<M>: DimMin<Const<M>, Output = Const<M>>,
 {
     (abar * h).exp()
-}
-
-/// The flow `exp(Ā h)` and the Gram integrals `∫₀^h exp(Āᵀs) Mᵢ exp(Ā s) ds` of `K` forms.
-pub fn flow_with_integrals<const M: usize, const K: usize>(
-    abar: &SMatrix<f64, M, M>,
-    forms: &[SMatrix<f64, M, M>; K],
-    h: f64,
-) -> (SMatrix<f64, M, M>, [SMatrix<f64, M, M>; K]) {
-    let n = (K + 1) * M;
-    let mut c = DMatrix::<f64>::zeros(n, n);
-    let minus_at = -abar.transpose() * h;
-    for (k, form) in forms.iter().enumerate() {
-        c.view_mut((k * M, k * M), (M, M)).copy_from(&minus_at);
-        c.view_mut((k * M, K * M), (M, M)).copy_from(&(form * h));
-    }
-    c.view_mut((K * M, K * M), (M, M)).copy_from(&(abar * h));
-    let e = c.exp();
-    let f22: SMatrix<f64, M, M> = e.fixed_view::<M, M>(K * M, K * M).into_owned();
-    let f22t = f22.transpose();
-    let ints = std::array::from_fn(|k| f22t * e.fixed_view::<M, M>(k * M, K * M));
-    (f22, ints)
 }
 
 /// The flow `exp(Ā h)` of a 10-dimensional augmented system and the Gramian
@@ -326,6 +306,28 @@ pub mod gauss {
 mod tests {
     use super::*;
     use nalgebra::{SMatrix, SVector};
+
+    /// Reference for the tests (Van Loan with the forms in the coupling block, one
+    /// `(K+1)M`-square exponential): the flow `exp(Ā h)` and the Gram integrals `∫₀^h exp(Āᵀs) Mᵢ exp(Ā s) ds` of `K` forms.
+    fn flow_with_integrals<const M: usize, const K: usize>(
+        abar: &SMatrix<f64, M, M>,
+        forms: &[SMatrix<f64, M, M>; K],
+        h: f64,
+    ) -> (SMatrix<f64, M, M>, [SMatrix<f64, M, M>; K]) {
+        let n = (K + 1) * M;
+        let mut c = DMatrix::<f64>::zeros(n, n);
+        let minus_at = -abar.transpose() * h;
+        for (k, form) in forms.iter().enumerate() {
+            c.view_mut((k * M, k * M), (M, M)).copy_from(&minus_at);
+            c.view_mut((k * M, K * M), (M, M)).copy_from(&(form * h));
+        }
+        c.view_mut((K * M, K * M), (M, M)).copy_from(&(abar * h));
+        let e = c.exp();
+        let f22: SMatrix<f64, M, M> = e.fixed_view::<M, M>(K * M, K * M).into_owned();
+        let f22t = f22.transpose();
+        let ints = std::array::from_fn(|k| f22t * e.fixed_view::<M, M>(k * M, K * M));
+        (f22, ints)
+    }
 
     type M3 = SMatrix<f64, 3, 3>;
 

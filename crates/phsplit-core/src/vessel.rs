@@ -352,6 +352,8 @@ pub struct VesselSystem<'a> {
     pub linear: LinearFlow,
     /// Stages of Gauss collocation when `linear` is `Gauss` (1, 2 or 3).
     pub gauss_stages: usize,
+    /// Kp, Kd, Ki translational then rotational, as diagonal matrices.
+    gain_mats: [Matrix3<f64>; 6],
 }
 
 /// The controller quantities at a given attitude: `W = Pi_e(theta)⁻¹ Q` and the
@@ -372,11 +374,21 @@ pub struct Power {
 
 impl<'a> VesselSystem<'a> {
     pub fn new(vessel: &'a Vessel, control_start: Option<f64>) -> Self {
+        let c = &vessel.control;
+        let d = |v: [f64; 3]| Matrix3::from_diagonal(&Vector3::from(v));
         Self {
             vessel,
             control_start,
             linear: LinearFlow::Exact,
             gauss_stages: 1,
+            gain_mats: [
+                d(c.kp_translational),
+                d(c.kd_translational),
+                d(c.ki_translational),
+                d(c.kp_rotational),
+                d(c.kd_rotational),
+                d(c.ki_rotational),
+            ],
         }
     }
 
@@ -406,24 +418,13 @@ impl<'a> VesselSystem<'a> {
         }
     }
 
-    /// Diagonal gains as matrices, zero when the controller is off.
+    /// Diagonal gains as matrices (built once, in [`Self::new`]), zero when the controller is off.
     fn gains(&self, on: bool) -> [Matrix3<f64>; 6] {
-        let c = &self.vessel.control;
-        let d = |v: [f64; 3]| {
-            if on {
-                Matrix3::from_diagonal(&Vector3::from(v))
-            } else {
-                Matrix3::zeros()
-            }
-        };
-        [
-            d(c.kp_translational),
-            d(c.kd_translational),
-            d(c.ki_translational),
-            d(c.kp_rotational),
-            d(c.kd_rotational),
-            d(c.ki_rotational),
-        ]
+        if on {
+            self.gain_mats
+        } else {
+            [Matrix3::zeros(); 6]
+        }
     }
 
     /// The full vector field, eq. (39), with the controller on or off.

@@ -47,7 +47,7 @@ def _toml_text(d: dict) -> str:
                 lines.append(f"{k} = [{', '.join(repr(float(x)) for x in v)}]")
             else:
                 lines.append(f"{k} = {float(v)!r}")
-    return "\n".join(lines).replace("nan", "nan").replace("inf", "inf")
+    return "\n".join(lines)
 
 
 def _resolve(d: dict, key: str) -> tuple[str, str, int | None]:
