@@ -291,7 +291,7 @@ pub fn run_runge_kutta<const N: usize, M: FieldModel<N>>(
             let mut yi = y;
             for (j, aij) in tableau.a[i].iter().enumerate() {
                 if *aij != 0.0 {
-                    yi += k[j] * (h * aij);
+                    yi.axpy(h * aij, &k[j], 1.0);
                 }
             }
             k[i] = model.rhs(t, &yi);
@@ -302,7 +302,7 @@ pub fn run_runge_kutta<const N: usize, M: FieldModel<N>>(
             }
         }
         for i in 0..s {
-            y += k[i] * (h * tableau.b[i]);
+            y.axpy(h * tableau.b[i], &k[i], 1.0);
         }
         rec.acc += work;
         let state = model.from_vector(&y);

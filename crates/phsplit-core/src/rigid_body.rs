@@ -141,15 +141,23 @@ impl FreeRigidBody {
         let sign = |x: f64| if x < 0.0 { -1.0 } else { 1.0 };
         let sigma_c = if k2 < 1.0 { 1.0 } else { sign(m0[c]) };
         let sigma_d = sign(m0[dd]);
-        let phi0 = (m0[mid] / mm).atan2(sigma_c * m0[c] / mc);
         let k2 = k2.min(1.0);
-        let nu = match ellipf(phi0, k2) {
-            Ok(v) if v.is_finite() => v,
-            _ => return fixed,
-        };
         let eps = levi_civita(c, mid, dd);
         let lambda =
             eps * sigma_c * sigma_d * (j[mid] - j[dd]).signum() * (b * d(j[mid], j[dd])).sqrt();
+        // (sn, cn, dn) at the start, read off m0: the amplitudes make them so.
+        let start = Jacobi {
+            s: m0[mid] / mm,
+            c: sigma_c * m0[c] / mc,
+            d: sigma_d * m0[dd] / md,
+        };
+        if !(start.s.is_finite()
+            && start.c.is_finite()
+            && start.d.is_finite()
+            && lambda.is_finite())
+        {
+            return fixed;
+        }
         Orbit {
             m0: *m0,
             data: Some(OrbitData {
@@ -157,13 +165,19 @@ impl FreeRigidBody {
                 amp: [sigma_c * mc, mm, sigma_d * md],
                 k2,
                 lambda,
-                nu,
+                start,
             }),
         }
     }
 
     /// Exact free flow of the momentum and Magnus attitude over `t`:
     /// returns `(m(t), Q(t))` from `(m0, Q0)` (paper §3.4.1).
+    ///
+    /// The elliptic functions are evaluated once per Magnus node, at the phase advance `λ t_i`
+    /// only; the momentum at each node follows from the addition theorem with the start
+    /// values ([`Orbit::momentum`]), and the end point from the addition of two symmetric
+    /// nodes (`c_i + c_{s+1−i} = 1`), so a flow costs 1, 2 or 3 evaluations of sn, cn, dn
+    /// for Magnus order 2, 4 or 6 and no elliptic integral.
     pub fn flow(
         &self,
         m0: &Vector3<f64>,
@@ -172,14 +186,57 @@ impl FreeRigidBody {
         order: MagnusOrder,
     ) -> (Vector3<f64>, Matrix3<f64>) {
         let orbit = self.orbit(m0);
-        let m1 = orbit.momentum(t);
-        let omega = magnus_omega(|s| self.omega(&orbit.momentum(s)), t, order);
+        // w at node c_i t, given (sn, cn, dn)(λ c_i t).
+        let w = |a: &Jacobi, ci: f64| self.omega(&orbit.momentum_at_advance(a, ci * t));
+        let (omega, m1) = match orbit.data {
+            None => {
+                let w0 = self.omega(m0);
+                (w0 * t, *m0)
+            }
+            Some(o) => {
+                let adv = |x: f64| o.advance(x * t);
+                let end = |a: &Jacobi, b: &Jacobi, tot: f64| {
+                    a.add(b, o.k2).unwrap_or_else(|| o.advance(tot * t))
+                };
+                match order {
+                    MagnusOrder::Two => {
+                        let a = adv(0.5);
+                        let e = end(&a, &a, 1.0);
+                        (
+                            magnus_from_samples(&[w(&a, 0.5)], t, order),
+                            orbit.momentum_at_advance(&e, t),
+                        )
+                    }
+                    MagnusOrder::Four => {
+                        let r = 3f64.sqrt() / 6.0;
+                        let (a1, a2) = (adv(0.5 - r), adv(0.5 + r));
+                        let e = end(&a1, &a2, 1.0);
+                        (
+                            magnus_from_samples(&[w(&a1, 0.5 - r), w(&a2, 0.5 + r)], t, order),
+                            orbit.momentum_at_advance(&e, t),
+                        )
+                    }
+                    MagnusOrder::Six => {
+                        let r = 15f64.sqrt() / 10.0;
+                        let (a1, a2, a3) = (adv(0.5 - r), adv(0.5), adv(0.5 + r));
+                        let e = end(&a1, &a3, 1.0);
+                        (
+                            magnus_from_samples(
+                                &[w(&a1, 0.5 - r), w(&a2, 0.5), w(&a3, 0.5 + r)],
+                                t,
+                                order,
+                            ),
+                            orbit.momentum_at_advance(&e, t),
+                        )
+                    }
+                }
+            }
+        };
         // Q0 exp(Ω) is orthogonal up to round-off; one Björck step keeps that round-off from
         // accumulating over long runs (‖QᵀQ − I‖ stays at 1e-15, not growing with the steps).
         (m1, so3::bjorck_step(&(q0 * so3::exp(&omega))))
     }
 }
-
 /// Sign of the permutation `(i, j, k)` of `(0, 1, 2)`.
 fn levi_civita(i: usize, j: usize, k: usize) -> f64 {
     match (i, j, k) {
@@ -196,7 +253,55 @@ struct OrbitData {
     amp: [f64; 3],
     k2: f64,
     lambda: f64,
-    nu: f64,
+    /// `(sn, cn, dn)` of the phase at the start.
+    start: Jacobi,
+}
+
+/// The triple `(sn, cn, dn)(u | k²)` at one argument.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Jacobi {
+    s: f64,
+    c: f64,
+    d: f64,
+}
+
+impl Jacobi {
+    fn at(u: f64, k2: f64) -> Self {
+        let (s, c, d) = jacobi(u, k2);
+        Self { s, c, d }
+    }
+
+    /// The addition theorem (DLMF 22.8.1–3): `(sn, cn, dn)(u + v)` from the values at `u` and
+    /// `v`, with the common denominator `1 − k² sn²u sn²v`. `None` when that denominator is
+    /// below 1/2 (near the separatrix, with both arguments near a quarter period), where it
+    /// would cost digits: the caller then evaluates directly. `dn` is recomputed as
+    /// `sqrt(k₁² + k² cn²)`, as in [`jacobi`], to keep its relative accuracy as `k² → 1`.
+    fn add(&self, o: &Jacobi, k2: f64) -> Option<Jacobi> {
+        let den = 1.0 - k2 * (self.s * o.s) * (self.s * o.s);
+        if !(den >= 0.5) {
+            return None;
+        }
+        let inv = 1.0 / den;
+        let s = (self.s * o.c * o.d + o.s * self.c * self.d) * inv;
+        let c = (self.c * o.c - self.s * o.s * self.d * o.d) * inv;
+        let d = ((1.0 - k2) + k2 * c * c).sqrt();
+        Some(Jacobi { s, c, d })
+    }
+}
+
+impl OrbitData {
+    /// `(sn, cn, dn)` of the phase advance `λ t` alone (not of the phase `λ t + ν`).
+    fn advance(&self, t: f64) -> Jacobi {
+        Jacobi::at(self.lambda * t, self.k2)
+    }
+
+    /// The phase `ν` at the start, `F(φ₀ | k²)` with `φ₀ = atan2(sn ν, cn ν)`: needed only
+    /// where the addition theorem is avoided.
+    fn nu(&self) -> Option<f64> {
+        ellipf(self.start.s.atan2(self.start.c), self.k2)
+            .ok()
+            .filter(|v| v.is_finite())
+    }
 }
 
 /// The exact momentum orbit of a free rigid body through a given `m0`.
@@ -207,16 +312,50 @@ pub struct Orbit {
 }
 
 impl Orbit {
-    /// Body angular momentum at time `t` after the start.
+    /// Body angular momentum at time `t` after the start: the addition theorem applied to the
+    /// start values and `(sn, cn, dn)(λt)`, or, where its denominator is small, directly
+    /// `(sn, cn, dn)(λt + ν)` with `ν = F(φ₀ | k²)`.
     pub fn momentum(&self, t: f64) -> Vector3<f64> {
+        match &self.data {
+            None => self.m0,
+            Some(o) => self.momentum_at_advance(&o.advance(t), t),
+        }
+    }
+
+    /// The momentum given `(sn, cn, dn)(λt)` (`t` is used only if the direct evaluation is
+    /// needed).
+    fn momentum_at_advance(&self, adv: &Jacobi, t: f64) -> Vector3<f64> {
         let Some(o) = &self.data else {
             return self.m0;
         };
-        let (sn, cn, dn) = jacobi(o.lambda * t + o.nu, o.k2);
+        let j = match o.start.add(adv, o.k2) {
+            Some(j) => j,
+            None => match o.nu() {
+                Some(nu) => Jacobi::at(o.lambda * t + nu, o.k2),
+                None => return Vector3::from_element(f64::NAN),
+            },
+        };
         let mut m = Vector3::zeros();
-        m[o.axes[0]] = o.amp[0] * cn;
-        m[o.axes[1]] = o.amp[1] * sn;
-        m[o.axes[2]] = o.amp[2] * dn;
+        m[o.axes[0]] = o.amp[0] * j.c;
+        m[o.axes[1]] = o.amp[1] * j.s;
+        m[o.axes[2]] = o.amp[2] * j.d;
+        m
+    }
+
+    /// The momentum at `t` by the direct evaluation `(sn, cn, dn)(λt + ν)`, without the
+    /// addition theorem (a cross-check for the tests).
+    pub fn momentum_direct(&self, t: f64) -> Vector3<f64> {
+        let Some(o) = &self.data else {
+            return self.m0;
+        };
+        let Some(nu) = o.nu() else {
+            return Vector3::from_element(f64::NAN);
+        };
+        let j = Jacobi::at(o.lambda * t + nu, o.k2);
+        let mut m = Vector3::zeros();
+        m[o.axes[0]] = o.amp[0] * j.c;
+        m[o.axes[1]] = o.amp[1] * j.s;
+        m[o.axes[2]] = o.amp[2] * j.d;
         m
     }
 
@@ -238,18 +377,32 @@ impl Orbit {
 /// Commutators of `hat` matrices are cross products: `[hat a, hat b] = hat(a × b)`.
 pub fn magnus_omega<F: Fn(f64) -> Vector3<f64>>(w: F, h: f64, order: MagnusOrder) -> Vector3<f64> {
     match order {
-        MagnusOrder::Two => w(0.5 * h) * h,
+        MagnusOrder::Two => magnus_from_samples(&[w(0.5 * h)], h, order),
         MagnusOrder::Four => {
             let r = 3f64.sqrt() / 6.0;
-            let (w1, w2) = (w((0.5 - r) * h), w((0.5 + r) * h));
+            magnus_from_samples(&[w((0.5 - r) * h), w((0.5 + r) * h)], h, order)
+        }
+        MagnusOrder::Six => {
+            let r = 15f64.sqrt() / 10.0;
+            magnus_from_samples(&[w((0.5 - r) * h), w(0.5 * h), w((0.5 + r) * h)], h, order)
+        }
+    }
+}
+
+/// [`magnus_omega`] from the samples `w(c_i h)` at the 1, 2 or 3 Gauss–Legendre nodes of
+/// the order.
+pub fn magnus_from_samples(w: &[Vector3<f64>], h: f64, order: MagnusOrder) -> Vector3<f64> {
+    match order {
+        MagnusOrder::Two => w[0] * h,
+        MagnusOrder::Four => {
+            let (w1, w2) = (w[0], w[1]);
             let a1 = (w1 + w2) * (0.5 * h);
             let a2 = (w2 - w1) * (3f64.sqrt() * h);
             // Right-multiplied form: + [α1, α2]/12.
             a1 + a1.cross(&a2) / 12.0
         }
         MagnusOrder::Six => {
-            let r = 15f64.sqrt() / 10.0;
-            let (w1, w2, w3) = (w((0.5 - r) * h), w(0.5 * h), w((0.5 + r) * h));
+            let (w1, w2, w3) = (w[0], w[1], w[2]);
             let a1 = w2 * h;
             let a2 = (w3 - w1) * (15f64.sqrt() * h / 3.0);
             let a3 = (w3 - w2 * 2.0 + w1) * (10.0 * h / 3.0);
@@ -333,6 +486,28 @@ mod tests {
                 let (mr, _) = reference(&b, m0, Matrix3::identity(), t);
                 assert!(rel(&m, &mr) < 1e-11, "{what}, t={t}: {m} vs {mr}");
             }
+        }
+    }
+
+    #[test]
+    fn direct_evaluation_takes_over_next_to_the_separatrix() {
+        // k² = 1 − 1e-12: the momentum passes close to the middle axis, where sn(ν) ≈ ±1; over a
+        // quarter period the addition theorem's denominator 1 − k² sn²ν sn²(λt) nears 1e-12
+        // and the direct evaluation must take over. Both are checked against a fine RK4.
+        let body = FreeRigidBody::new(Vector3::new(1.0, 2.0, 3.0)).unwrap();
+        // The separatrix of this body (J = T⁻¹) is m_lo² (J1 − J2) = m_hi² (J2 − J3).
+        let (j1, j2, j3): (f64, f64, f64) = (1.0, 0.5, 1.0 / 3.0);
+        let m_hi = 0.3;
+        let m_lo = m_hi * ((j2 - j3) / (j1 - j2)).sqrt() * (1.0 - 1e-12);
+        let m0 = Vector3::new(m_lo, 1.0, m_hi);
+        let orbit = body.orbit(&m0);
+        let k2 = orbit.parameter().unwrap();
+        assert!(k2 < 1.0 && k2 > 1.0 - 1e-9, "k² = {k2}");
+        let q0 = Matrix3::identity();
+        for t in [0.5, 3.0, 9.0, 14.0] {
+            let (mr, _) = reference(&body, m0, q0, t);
+            assert!(rel(&orbit.momentum(t), &mr) < 1e-9, "t={t}");
+            assert!(rel(&orbit.momentum_direct(t), &mr) < 1e-9, "t={t}");
         }
     }
 
@@ -469,6 +644,22 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn addition_theorem_agrees_with_the_direct_phase(
+            i1 in 0.2f64..5.0, i2 in 0.2f64..5.0, i3 in 0.2f64..5.0,
+            m1 in -2.0f64..2.0, m2 in -2.0f64..2.0, m3 in -2.0f64..2.0,
+            t in -40.0f64..40.0,
+        ) {
+            // Orbit::momentum (addition theorem from the start values, direct evaluation where
+            // its denominator is small) against (sn, cn, dn)(λt + ν) with ν = F(φ₀ | k²).
+            let body = FreeRigidBody::new(Vector3::new(i1, i2, i3)).unwrap();
+            let orbit = body.orbit(&Vector3::new(m1, m2, m3));
+            let (a, b) = (orbit.momentum(t), orbit.momentum_direct(t));
+            let scale = Vector3::new(m1, m2, m3).norm().max(1e-300);
+            prop_assert!((a - b).norm() <= 2e-13 * scale * (1.0 + t.abs() * 0.1), "{a} vs {b}");
+            prop_assert!((a.norm() - scale).abs() <= 1e-14 * scale * 4.0);
+        }
+
         #[test]
         fn invariants_and_agreement_over_random_bodies(
             i1 in 0.2f64..5.0, i2 in 0.2f64..5.0, i3 in 0.2f64..5.0,

@@ -113,10 +113,39 @@ pub fn from_euler_zyx(e: &Vector3<f64>) -> Matrix3<f64> {
 /// Runge–Kutta attitude) still gets angles. The pitch uses `atan2` on `−Q31` against the norm of
 /// the first column's other entries, which stays accurate near ±π/2 where `asin` would not.
 pub fn euler_zyx(q: &Matrix3<f64>) -> Vector3<f64> {
-    let phi = q[(2, 1)].atan2(q[(2, 2)]);
-    let theta = (-q[(2, 0)]).atan2(q[(0, 0)].hypot(q[(1, 0)]));
-    let psi = q[(1, 0)].atan2(q[(0, 0)]);
+    let rho = (q[(0, 0)] * q[(0, 0)] + q[(1, 0)] * q[(1, 0)]).sqrt();
+    euler_zyx_with(q, rho)
+}
+
+/// [`euler_zyx`] given `rho = |(Q11, Q21)|` (shared with [`pi_e_inv_of`] by [`euler_and_w`]).
+/// `atan2` is musl's (the `libm` crate, within 1 ulp).
+fn euler_zyx_with(q: &Matrix3<f64>, rho: f64) -> Vector3<f64> {
+    let phi = libm::atan2(q[(2, 1)], q[(2, 2)]);
+    let theta = libm::atan2(-q[(2, 0)], rho);
+    let psi = libm::atan2(q[(1, 0)], q[(0, 0)]);
     Vector3::new(phi, theta, psi)
+}
+
+/// The ZYX Euler angles of `q` and `W = Pi_e(theta)⁻¹ q` (the controller's map from body
+/// angular velocity to Euler-angle rates), with the trigonometric functions of the angles
+/// read off the entries of `q` as in [`pi_e_inv_of`]. Rows of `W`, with `r_i` the rows of
+/// `q`: `W_0 = sec θ (cos ψ r_0 + sin ψ r_1)`, `W_1 = cos ψ r_1 − sin ψ r_0`,
+/// `W_2 = tan θ (cos ψ r_0 + sin ψ r_1) + r_2`.
+pub fn euler_and_w(q: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+    let (q00, q10, q20) = (q[(0, 0)], q[(1, 0)], q[(2, 0)]);
+    let rho2 = q00 * q00 + q10 * q10;
+    let rho = rho2.sqrt();
+    let r = (rho2 + q20 * q20).sqrt();
+    let inv = 1.0 / rho;
+    let (cp, sp) = (q00 * inv, q10 * inv);
+    let (tt, sec) = (-q20 * inv, r * inv);
+    let (r0, r1, r2) = (q.row(0), q.row(1), q.row(2));
+    let a = r0 * cp + r1 * sp;
+    let mut w = Matrix3::zeros();
+    w.set_row(0, &(a * sec));
+    w.set_row(1, &(r1 * cp - r0 * sp));
+    w.set_row(2, &(a * tt + r2));
+    (euler_zyx_with(q, rho), w)
 }
 
 /// `Pi_e(theta)`: maps ZYX Euler-angle rates to the spatial angular velocity,
@@ -149,8 +178,8 @@ pub fn pi_e_inv(e: &Vector3<f64>) -> Matrix3<f64> {
 /// (`cos ψ = Q11/ρ, sin ψ = Q21/ρ, ρ = hypot(Q11, Q21)`; `cos θ = ρ/r, sin θ = −Q31/r`,
 /// `r = |first column|`). Equals `pi_e_inv(&euler_zyx(q))` to rounding, with no trigonometry.
 pub fn pi_e_inv_of(q: &Matrix3<f64>) -> Matrix3<f64> {
-    let rho = q[(0, 0)].hypot(q[(1, 0)]);
-    let r = rho.hypot(q[(2, 0)]);
+    let rho = (q[(0, 0)] * q[(0, 0)] + q[(1, 0)] * q[(1, 0)]).sqrt();
+    let r = (rho * rho + q[(2, 0)] * q[(2, 0)]).sqrt();
     let (cp, sp) = (q[(0, 0)] / rho, q[(1, 0)] / rho);
     let tt = -q[(2, 0)] / rho; // tan θ
     let sec = r / rho; // 1 / cos θ
@@ -299,6 +328,22 @@ mod tests {
         let mut nq = q * 1.001;
         nq[(2, 0)] += 1e-4;
         assert!((pi_e_inv_of(&nq) - pi_e_inv(&euler_zyx(&nq))).norm() < 1e-14);
+        // The fused angles-and-W equals its parts, for rotations across the chart and the
+        // nearly orthogonal matrix.
+        for (i, m) in [
+            q,
+            nq,
+            exp(&Vector3::new(1.2, -0.7, 2.9)),
+            exp(&Vector3::new(-0.3, 1.1, -2.5)),
+        ]
+        .iter()
+        .enumerate()
+        {
+            let (ang, w) = euler_and_w(m);
+            assert!((ang - euler_zyx(m)).norm() < 1e-15, "case {i}");
+            let want = pi_e_inv(&euler_zyx(m)) * m;
+            assert!((w - want).norm() < 1e-14 * want.norm(), "case {i}");
+        }
     }
 
     #[test]

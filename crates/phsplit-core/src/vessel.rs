@@ -10,7 +10,7 @@
 //! `dH/dt = νᵀτ − νᵀDν` with `ν = (v, w)`.
 
 use crate::error::{Error, Result};
-use crate::linear;
+use crate::linear::{self, gauss};
 use crate::methods::Flow;
 use crate::rigid_body::{FreeRigidBody, MagnusOrder};
 use crate::so3;
@@ -408,13 +408,13 @@ impl<'a> VesselSystem<'a> {
     }
 
     fn frozen(&self, q: &Matrix3<f64>) -> Frozen {
-        let theta = so3::euler_zyx(q);
+        let (theta, w_mat) = so3::euler_and_w(q);
         let theta_ref = Vector3::from(self.vessel.control.euler_reference);
         Frozen {
             q: *q,
-            q3: q.transpose() * Vector3::z(),
+            q3: q.row(2).transpose(),
             theta_err: theta - theta_ref,
-            w_mat: so3::pi_e_inv_of(q) * q,
+            w_mat,
         }
     }
 
@@ -533,70 +533,205 @@ impl<'a> VesselSystem<'a> {
         s.q = q1;
     }
 
-    /// The two augmented affine systems of flow S2 at the frozen attitude `Q0` (paper eq. 41):
-    /// translation in `z = (p, x − x_ref, phi_x, 1)`, rotation in `z = (m, mu, phi_th, 1)`, with the
-    /// quadratic forms of supplied and dissipated power in the same variables.
-    fn s2_systems(&self, q0: &Matrix3<f64>, on: bool, ledger: bool) -> [S2Block; 2] {
+    /// Flow S2 at the frozen attitude `Q0` (paper eq. 41) as two block systems
+    /// ([`gauss::Blocks`]): translation in `(p, x − x_ref, phi_x)`, rotation in
+    /// `(m, mu, phi_th)`. Assembled directly in 3×3 blocks; the diagonal gains and inertias are
+    /// applied as row and column scalings, not as matrix products.
+    fn s2_at(&self, q0: &Matrix3<f64>, on: bool) -> S2At {
         let vsl = self.vessel;
+        let c = &vsl.control;
         let f = self.frozen(q0);
-        let [kp_t, kd_t, ki_t, kp_r, kd_r, ki_r] = self.gains(on);
         let mv = vsl.hull.mass;
-        let i3 = Matrix3::identity();
-        let xr = Vector3::from(vsl.control.position_reference);
+        let k = if on { 1.0 } else { 0.0 };
+        let kv = |a: [f64; 3]| Vector3::from(a) * k;
         let qt = q0.transpose();
-        let lam = Matrix3::from_diagonal(&Vector3::new(0.0, 0.0, vsl.heave_stiffness()));
-        // Translation.
-        let d_t =
-            Matrix3::from_diagonal(&Vector3::from(vsl.hull.damping_translational)) + qt * kd_t * q0;
-        // In the set-point error e = x − x_ref rather than x: the port's quadratic form then
-        // has no large terms that cancel (with x ≈ x_ref ≈ 780 m they cost six digits).
-        let mut at = SMatrix::<f64, 10, 10>::zeros();
-        at.fixed_view_mut::<3, 3>(0, 0).copy_from(&(-d_t / mv));
-        at.fixed_view_mut::<3, 3>(0, 3)
-            .copy_from(&(-qt * (lam + kp_t)));
-        at.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-qt * ki_t));
-        at.fixed_view_mut::<3, 1>(0, 9).copy_from(&(-qt * lam * xr));
-        at.fixed_view_mut::<3, 3>(3, 0).copy_from(&(q0 / mv));
-        if on {
-            at.fixed_view_mut::<3, 3>(6, 3).copy_from(&i3);
+        // Qᵀ diag(g): column j of Qᵀ times g_j.
+        let qt_diag = |g: &Vector3<f64>| {
+            let mut m = qt;
+            for j in 0..3 {
+                m.column_mut(j).scale_mut(g[j]);
+            }
+            m
+        };
+        let c_heave = vsl.heave_stiffness();
+        let xr = Vector3::from(c.position_reference);
+        // Translation. In the set-point error e = x − x_ref rather than x: the port's quadratic
+        // form then has no large terms that cancel (with x ≈ x_ref ≈ 780 m they cost six digits).
+        let kd_t = kv(c.kd_translational);
+        let mut d_t = qt_diag(&kd_t) * q0;
+        for i in 0..3 {
+            d_t[(i, i)] += vsl.hull.damping_translational[i];
         }
-        // The ledger's quadratic forms, built only when asked for.
-        let mut dis_t = SMatrix::<f64, 10, 10>::zeros();
-        let mut sup_t = SMatrix::<f64, 10, 10>::zeros();
-        if ledger {
-            dis_t
-                .fixed_view_mut::<3, 3>(0, 0)
-                .copy_from(&(d_t / (mv * mv)));
-            // v·tau_PI = (p/mv)ᵀ(−Qᵀ Kp e − Qᵀ Ki phi_x), symmetrised.
-            put_sym(&mut sup_t, 0, 3, &(-qt * kp_t / mv));
-            put_sym(&mut sup_t, 0, 6, &(-qt * ki_t / mv));
-        }
+        let qt_kp = qt_diag(&kv(c.kp_translational));
+        let mut qt_lam_kp = qt_kp;
+        qt_lam_kp.column_mut(2).axpy(c_heave, &qt.column(2), 1.0);
+        let trans = gauss::Blocks {
+            auu: d_t * (-1.0 / mv),
+            auv: -qt_lam_kp,
+            auw: -qt_diag(&kv(c.ki_translational)),
+            cu: qt.column(2) * (-c_heave * xr.z),
+            avu: q0 * (1.0 / mv),
+            awv: Matrix3::identity() * k,
+            cw: Vector3::zeros(),
+        };
         // Rotation.
-        let tinv = Matrix3::from_diagonal(&vsl.inertia().map(|v| 1.0 / v));
+        let tinv = vsl.inertia().map(|v| 1.0 / v);
         let wm = f.w_mat;
         let wt = wm.transpose();
-        let d_r =
-            Matrix3::from_diagonal(&Vector3::from(vsl.hull.damping_rotational)) + wt * kd_r * wm;
-        let hq3 = so3::hat(&f.q3);
-        let g = Matrix3::from_diagonal(&vsl.g_diag());
-        let mut ar = SMatrix::<f64, 10, 10>::zeros();
-        ar.fixed_view_mut::<3, 3>(0, 0).copy_from(&(-d_r * tinv));
-        ar.fixed_view_mut::<3, 3>(0, 3).copy_from(&hq3);
-        ar.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-wt * ki_r));
-        ar.fixed_view_mut::<3, 1>(0, 9)
-            .copy_from(&(-wt * kp_r * f.theta_err));
-        ar.fixed_view_mut::<3, 3>(3, 0).copy_from(&(g * hq3 * tinv));
-        if on {
-            ar.fixed_view_mut::<3, 1>(6, 9).copy_from(&f.theta_err);
+        let wt_diag = |g: &Vector3<f64>| {
+            let mut m = wt;
+            for j in 0..3 {
+                m.column_mut(j).scale_mut(g[j]);
+            }
+            m
+        };
+        let mut d_r = wt_diag(&kv(c.kd_rotational)) * wm;
+        for i in 0..3 {
+            d_r[(i, i)] += vsl.hull.damping_rotational[i];
         }
+        let mut auu_r = -d_r;
+        for j in 0..3 {
+            auu_r.column_mut(j).scale_mut(tinv[j]);
+        }
+        let hq3 = so3::hat(&f.q3);
+        let g = vsl.g_diag();
+        let mut avu_r = hq3;
+        for i in 0..3 {
+            for j in 0..3 {
+                avu_r[(i, j)] *= g[i] * tinv[j];
+            }
+        }
+        let rot = gauss::Blocks {
+            auu: auu_r,
+            auv: hq3,
+            auw: -wt_diag(&kv(c.ki_rotational)),
+            cu: -(wt * kv(c.kp_rotational).component_mul(&f.theta_err)),
+            avu: avu_r,
+            awv: Matrix3::zeros(),
+            cw: f.theta_err * k,
+        };
+        S2At {
+            trans,
+            rot,
+            qt_kp: -qt_kp,
+            tinv,
+            mv,
+        }
+    }
+
+    /// Flow S2 over `h` (paper §3.4.2): two affine systems solved by matrix exponentials
+    /// (or Gauss collocation, see [`LinearFlow`]). With `ledger`, also the supplied and
+    /// dissipated energy over the sub-step, exactly (Van Loan Gramian, or Gauss quadrature).
+    pub fn flow_s2(&self, s: &mut VesselState, h: f64, on: bool, ledger: bool) -> Power {
+        let at = self.s2_at(&s.q, on);
+        let xr = Vector3::from(self.vessel.control.position_reference);
+        let zt = [s.p, s.x - xr, s.phi_x];
+        let zr = [s.m, s.mu, s.phi_th];
+        let (zt1, zr1, work) = match self.linear {
+            LinearFlow::Gauss => self.gauss_s2(&at, &zt, &zr, h, ledger),
+            LinearFlow::Exact => {
+                let (bt, br) = at.augmented(ledger, self.vessel);
+                let (zt1, wt) = bt.advance(&zt, h, ledger);
+                let (zr1, wr) = br.advance(&zr, h, ledger);
+                let work = Power {
+                    supplied: wt.supplied + wr.supplied,
+                    dissipated: wt.dissipated + wr.dissipated,
+                };
+                (zt1, zr1, work)
+            }
+        };
+        s.p = zt1[0];
+        s.x = xr + zt1[1];
+        s.phi_x = zt1[2];
+        s.m = zr1[0];
+        s.mu = zr1[1];
+        s.phi_th = zr1[2];
+        work
+    }
+
+    /// Flow S2 by Gauss collocation on the block systems; with `ledger`, the supplied and
+    /// dissipated energy by the Gauss quadrature of the power at the stages (exact for the
+    /// collocation polynomial's quadratic storage: `H(z1) − H(z0) = h Σ b_i Ḣ(Z_i)`).
+    /// A singular stage system (impossible for a dissipative system, but checked) yields a
+    /// non-finite state.
+    fn gauss_s2(
+        &self,
+        at: &S2At,
+        zt: &gauss::Z3,
+        zr: &gauss::Z3,
+        h: f64,
+        ledger: bool,
+    ) -> (gauss::Z3, gauss::Z3, Power) {
+        let s = self.gauss_stages;
+        let nan = [Vector3::from_element(f64::NAN); 3];
+        let mut work = Power::default();
+        let (Some((zt1, st)), Some((zr1, sr))) = (
+            gauss::blocks_step(&at.trans, zt, h, s),
+            gauss::blocks_step(&at.rot, zr, h, s),
+        ) else {
+            return (nan, nan, work);
+        };
+        if ledger {
+            let b = gauss::weights(s);
+            for i in 0..s {
+                let p = at.stage_power(&st[i], &sr[i]);
+                work.supplied += h * b[i] * p.supplied;
+                work.dissipated += h * b[i] * p.dissipated;
+            }
+        }
+        (zt1, zr1, work)
+    }
+}
+
+/// Flow S2 at a frozen attitude, in blocks, with what the ledger needs besides.
+struct S2At {
+    trans: gauss::Blocks,
+    rot: gauss::Blocks,
+    /// `−Qᵀ Kp_t`: the proportional part of the translational port.
+    qt_kp: Matrix3<f64>,
+    tinv: Vector3<f64>,
+    mv: f64,
+}
+
+impl S2At {
+    /// Supplied (P and I) and dissipated (damping plus D) power at a state of the two block
+    /// systems: `v·τ_PI + w·τ_PI` and `vᵀD_t v + wᵀD_r w`, with `D_t = −m_v A_uu`,
+    /// `D_r T⁻¹ = −A_uu` (rotation).
+    fn stage_power(&self, zt: &gauss::Z3, zr: &gauss::Z3) -> Power {
+        let v = zt[0] / self.mv;
+        let w = zr[0].component_mul(&self.tinv);
+        let tau_t = self.qt_kp * zt[1] + self.trans.auw * zt[2];
+        let tau_r = self.rot.cu + self.rot.auw * zr[2];
+        Power {
+            supplied: v.dot(&tau_t) + w.dot(&tau_r),
+            dissipated: -v.dot(&(self.trans.auu * zt[0])) - w.dot(&(self.rot.auu * zr[0])),
+        }
+    }
+
+    /// The two systems as balanced 10×10 augmented matrices for the exact exponential, with
+    /// the quadratic forms of supplied and dissipated power (built only with `ledger`).
+    fn augmented(&self, ledger: bool, vsl: &Vessel) -> (S2Block, S2Block) {
+        let mv = self.mv;
+        let tinv = Matrix3::from_diagonal(&self.tinv);
+        let mut dis_t = SMatrix::<f64, 10, 10>::zeros();
+        let mut sup_t = SMatrix::<f64, 10, 10>::zeros();
         let mut dis_r = SMatrix::<f64, 10, 10>::zeros();
         let mut sup_r = SMatrix::<f64, 10, 10>::zeros();
         if ledger {
+            // vᵀ D_t v with v = p/mv, D_t = −mv A_uu.
+            dis_t
+                .fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(-self.trans.auu / mv));
+            // v·τ_PI = (p/mv)ᵀ(−Qᵀ Kp e − Qᵀ Ki phi_x), symmetrised.
+            put_sym(&mut sup_t, 0, 3, &(self.qt_kp / mv));
+            put_sym(&mut sup_t, 0, 6, &(self.trans.auw / mv));
+            // wᵀ D_r w with w = T⁻¹ m: T⁻¹ D_r T⁻¹ = −T⁻¹ A_uu, symmetrised against round-off.
+            let dr = -tinv * self.rot.auu;
             dis_r
                 .fixed_view_mut::<3, 3>(0, 0)
-                .copy_from(&(tinv * d_r * tinv));
-            put_sym(&mut sup_r, 0, 6, &(-tinv * wt * ki_r));
-            put_sym_col(&mut sup_r, 0, 9, &(-tinv * wt * kp_r * f.theta_err));
+                .copy_from(&((dr + dr.transpose()) * 0.5));
+            put_sym(&mut sup_r, 0, 6, &(tinv * self.rot.auw));
+            put_sym_col(&mut sup_r, 0, 9, &(tinv * self.rot.cu));
         }
         let gmax = vsl.g_diag().max();
         let scale_t = SVector::<f64, 10>::from_fn(|i, _| if i < 3 { mv } else { 1.0 });
@@ -605,55 +740,24 @@ impl<'a> VesselSystem<'a> {
             3..=5 => gmax,
             _ => 1.0,
         });
-        [
+        (
             S2Block {
-                abar: at,
+                abar: self.trans.augmented(),
                 supplied: sup_t,
                 dissipated: dis_t,
                 scale: scale_t,
             },
             S2Block {
-                abar: ar,
+                abar: self.rot.augmented(),
                 supplied: sup_r,
                 dissipated: dis_r,
                 scale: scale_r,
             },
-        ]
-    }
-
-    /// Flow S2 over `h` (paper §3.4.2): two affine systems solved by matrix exponentials
-    /// (or Gauss collocation, see [`LinearFlow`]). With `ledger`, also the supplied and
-    /// dissipated energy over the sub-step, exactly (Van Loan Gramian, or Gauss quadrature).
-    pub fn flow_s2(&self, s: &mut VesselState, h: f64, on: bool, ledger: bool) -> Power {
-        let [bt, br] = self.s2_systems(&s.q, on, ledger);
-        let mut zt = SVector::<f64, 10>::zeros();
-        zt.fixed_rows_mut::<3>(0).copy_from(&s.p);
-        let xr = Vector3::from(self.vessel.control.position_reference);
-        zt.fixed_rows_mut::<3>(3).copy_from(&(s.x - xr));
-        zt.fixed_rows_mut::<3>(6).copy_from(&s.phi_x);
-        zt[9] = 1.0;
-        let mut zr = SVector::<f64, 10>::zeros();
-        zr.fixed_rows_mut::<3>(0).copy_from(&s.m);
-        zr.fixed_rows_mut::<3>(3).copy_from(&s.mu);
-        zr.fixed_rows_mut::<3>(6).copy_from(&s.phi_th);
-        zr[9] = 1.0;
-        let stages = self.gauss_stages;
-        let (zt, wt) = bt.advance(&zt, h, self.linear, stages, ledger);
-        let (zr, wr) = br.advance(&zr, h, self.linear, stages, ledger);
-        let work = Power {
-            supplied: wt.supplied + wr.supplied,
-            dissipated: wt.dissipated + wr.dissipated,
-        };
-        s.p = zt.fixed_rows::<3>(0).into();
-        s.x = xr + zt.fixed_rows::<3>(3);
-        s.phi_x = zt.fixed_rows::<3>(6).into();
-        s.m = zr.fixed_rows::<3>(0).into();
-        s.mu = zr.fixed_rows::<3>(3).into();
-        s.phi_th = zr.fixed_rows::<3>(6).into();
-        work
+        )
     }
 }
 
+/// One of the S2 systems as an augmented 10×10 matrix, for the exact exponential.
 struct S2Block {
     abar: SMatrix<f64, 10, 10>,
     supplied: SMatrix<f64, 10, 10>,
@@ -676,64 +780,35 @@ impl S2Block {
         SMatrix::from_fn(|i, j| m[(i, j)] * s[i] * s[j])
     }
 
-    /// Advance `z` over `h` by the exact flow or Gauss collocation with `stages` stages; with
-    /// `ledger`, also the supplied and dissipated energy. A singular collocation system (not
-    /// possible for a dissipative system, but checked) yields a non-finite state.
-    fn advance(
-        &self,
-        z: &SVector<f64, 10>,
-        h: f64,
-        kind: LinearFlow,
-        stages: usize,
-        ledger: bool,
-    ) -> (SVector<f64, 10>, Power) {
+    /// Advance `z` over `h` by the exact flow; with `ledger`, also the supplied and dissipated
+    /// energy (exact integrals of the quadratic forms along the flow).
+    fn advance(&self, z: &gauss::Z3, h: f64, ledger: bool) -> (gauss::Z3, Power) {
         let sc = &self.scale;
-        let zb = z.component_div(sc);
+        let mut zz = SVector::<f64, 10>::zeros();
+        for (k, v) in z.iter().enumerate() {
+            zz.fixed_rows_mut::<3>(3 * k).copy_from(v);
+        }
+        zz[9] = 1.0;
+        let zb = zz.component_div(sc);
         let a = self.balanced();
         let mut work = Power::default();
-        let zb1 = match (kind, ledger) {
-            (LinearFlow::Exact, false) => Some(linear::flow(&a, h) * zb),
-            (LinearFlow::Exact, true) => {
-                let (f, gram) = linear::flow_and_gramian(&a, &zb, h);
-                work.supplied = linear::trace_product(&self.balanced_form(&self.supplied), &gram);
-                work.dissipated =
-                    linear::trace_product(&self.balanced_form(&self.dissipated), &gram);
-                Some(f * zb)
-            }
-            (LinearFlow::Gauss, _) => match linear::gauss::structured(&a, &zb, h, stages) {
-                // The S2 blocks have the structure the elimination needs: one 3s×3s solve.
-                Some((z1, ys, b)) => {
-                    if ledger {
-                        let (ms, md) = (
-                            self.balanced_form(&self.supplied),
-                            self.balanced_form(&self.dissipated),
-                        );
-                        for (y, bi) in ys.iter().zip(b).take(stages) {
-                            work.supplied += h * bi * y.dot(&(ms * y));
-                            work.dissipated += h * bi * y.dot(&(md * y));
-                        }
-                    }
-                    Some(z1)
-                }
-                // A singular reduced system: fall back to the dense collocation.
-                None if !ledger => linear::gauss::step(&a, &zb, h, stages),
-                None => linear::gauss::stages(&a, &zb, h, stages).map(|(z1, ys, b)| {
-                    let (ms, md) = (
-                        self.balanced_form(&self.supplied),
-                        self.balanced_form(&self.dissipated),
-                    );
-                    for (y, bi) in ys.iter().zip(b) {
-                        work.supplied += h * bi * y.dot(&(ms * y));
-                        work.dissipated += h * bi * y.dot(&(md * y));
-                    }
-                    z1
-                }),
-            },
+        let zb1 = if ledger {
+            let (f, gram) = linear::flow_and_gramian(&a, &zb, h);
+            work.supplied = linear::trace_product(&self.balanced_form(&self.supplied), &gram);
+            work.dissipated = linear::trace_product(&self.balanced_form(&self.dissipated), &gram);
+            f * zb
+        } else {
+            linear::flow(&a, h) * zb
         };
-        match zb1 {
-            Some(v) => (v.component_mul(sc), work),
-            None => (SVector::from_element(f64::NAN), work),
-        }
+        let z1 = zb1.component_mul(sc);
+        (
+            [
+                z1.fixed_rows::<3>(0).into_owned(),
+                z1.fixed_rows::<3>(3).into_owned(),
+                z1.fixed_rows::<3>(6).into_owned(),
+            ],
+            work,
+        )
     }
 }
 
