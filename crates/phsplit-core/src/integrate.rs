@@ -301,20 +301,27 @@ pub fn run_runge_kutta<const N: usize, M: FieldModel<N>>(
                 work.dissipated += h * tableau.b[i] * p.dissipated;
             }
         }
+        let mut y1 = y;
         for i in 0..s {
-            y.axpy(h * tableau.b[i], &k[i], 1.0);
+            y1.axpy(h * tableau.b[i], &k[i], 1.0);
         }
-        rec.acc += work;
-        let state = model.from_vector(&y);
-        if !model.is_finite(&state) {
+        // Finiteness is checked on the vector; the state is built only when it is saved, and
+        // the last good state at the end (or at a failure: `y` is then the last good one).
+        if !y1.as_slice().iter().all(|v| v.is_finite()) {
+            rec.traj.last_good = model.from_vector(&y);
+            rec.traj.t_last_good = t;
             return Ok(rec.fail(n, t));
         }
+        y = y1;
+        rec.acc += work;
         rec.traj.steps = n + 1;
-        rec.traj.last_good = state;
-        rec.traj.t_last_good = t + h;
         if saves_after(n, opts) {
-            rec.save(t + h, state);
+            rec.save(t + h, model.from_vector(&y));
         }
+    }
+    if opts.n_steps > 0 {
+        rec.traj.last_good = model.from_vector(&y);
+        rec.traj.t_last_good = opts.t0 + opts.n_steps as f64 * h;
     }
     Ok(rec.traj)
 }

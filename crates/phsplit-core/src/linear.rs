@@ -428,17 +428,28 @@ pub mod gauss {
         let [u0, v0, w0] = z0;
         let p2 = sys.auv * sys.avu;
         let avu_u0 = sys.avu * u0;
-        let awv_avu_u0 = sys.awv * avu_u0;
+        // A_wv = 0 (the rotation: phi_th grows at a constant rate) leaves out the cubic terms.
+        let cubic = sys.awv.iter().any(|v| *v != 0.0);
+        let awv_avu_u0 = if cubic {
+            sys.awv * avu_u0
+        } else {
+            Vector3::zeros()
+        };
+        let fw0 = if cubic { sys.cw + sys.awv * v0 } else { sys.cw };
         // Right-hand side R_i = hα_i f_u(z0) + h²(𝒜²1)_i g₂ + h³(𝒜³1)_i g₃.
         let g1 = sys.auu * u0 + sys.auv * v0 + sys.auw * w0 + sys.cu;
-        let g2 = sys.auw * (sys.cw + sys.awv * v0) + sys.auv * avu_u0;
+        let g2 = sys.auw * fw0 + sys.auv * avu_u0;
         let g3 = sys.auw * awv_avu_u0;
         let (h2, h3) = (h * h, h * h * h);
         let rhs = |i: usize| {
             g1 * (h * tr.pow1[0][i]) + g2 * (h2 * tr.pow1[1][i]) + g3 * (h3 * tr.pow1[2][i])
         };
         let r = [rhs(0), rhs(1), rhs(2)];
-        let p3 = sys.auw * sys.awv * sys.avu;
+        let p3 = if cubic {
+            sys.auw * (sys.awv * sys.avu)
+        } else {
+            Matrix3::zeros()
+        };
         let mut du = [Vector3::zeros(); 3];
         for mode in &tr.modes[..tr.n_modes] {
             let (l1, l2, l3) = (
@@ -457,13 +468,9 @@ pub mod gauss {
                     du[i] += x * mode.tau[i].re;
                 }
             } else {
-                let m = Matrix3::from_fn(|i, j| {
-                    let id = if i == j { 1.0 } else { 0.0 };
-                    Complex::new(
-                        id - sys.auu[(i, j)] * l1.re - p2[(i, j)] * l2.re - p3[(i, j)] * l3.re,
-                        -sys.auu[(i, j)] * l1.im - p2[(i, j)] * l2.im - p3[(i, j)] * l3.im,
-                    )
-                });
+                let re = Matrix3::identity() - sys.auu * l1.re - p2 * l2.re - p3 * l3.re;
+                let im = -(sys.auu * l1.im + p2 * l2.im + p3 * l3.im);
+                let m = re.zip_map(&im, Complex::new);
                 let mut rh = Vector3::<Complex<f64>>::zeros();
                 for i in 0..s {
                     rh += r[i].map(Complex::from) * mode.t[i];
@@ -485,8 +492,11 @@ pub mod gauss {
             }
             dv[i] = acc * h;
         }
-        let fw0 = sys.cw + sys.awv * v0;
-        let awv_dv = [sys.awv * dv[0], sys.awv * dv[1], sys.awv * dv[2]];
+        let awv_dv = if cubic {
+            [sys.awv * dv[0], sys.awv * dv[1], sys.awv * dv[2]]
+        } else {
+            [Vector3::zeros(); 3]
+        };
         let mut dw = [Vector3::zeros(); 3];
         for i in 0..s {
             let mut acc = fw0 * tr.pow1[0][i];

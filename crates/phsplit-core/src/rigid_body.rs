@@ -173,11 +173,12 @@ impl FreeRigidBody {
     /// Exact free flow of the momentum and Magnus attitude over `t`:
     /// returns `(m(t), Q(t))` from `(m0, Q0)` (paper §3.4.1).
     ///
-    /// The elliptic functions are evaluated once per Magnus node, at the phase advance `λ t_i`
-    /// only; the momentum at each node follows from the addition theorem with the start
-    /// values ([`Orbit::momentum`]), and the end point from the addition of two symmetric
-    /// nodes (`c_i + c_{s+1−i} = 1`), so a flow costs 1, 2 or 3 evaluations of sn, cn, dn
-    /// for Magnus order 2, 4 or 6 and no elliptic integral.
+    /// The elliptic functions are evaluated at phase advances `λ c_i t` only; the momentum at
+    /// each node follows from the addition theorem with the start values
+    /// ([`Orbit::momentum`]), the end point from the addition of two symmetric nodes
+    /// (`c_i + c_{s+1−i} = 1`), and for order 6 the outer nodes `1/2 ∓ r` from the values at
+    /// `1/2` and `r`. A flow costs 1, 2 or 2 evaluations of sn, cn, dn for Magnus order 2, 4
+    /// or 6, and no elliptic integral.
     pub fn flow(
         &self,
         m0: &Vector3<f64>,
@@ -217,9 +218,12 @@ impl FreeRigidBody {
                         )
                     }
                     MagnusOrder::Six => {
+                        // Nodes 1/2 ∓ r from (sn, cn, dn) at 1/2 and at r: two evaluations.
                         let r = 15f64.sqrt() / 10.0;
-                        let (a1, a2, a3) = (adv(0.5 - r), adv(0.5), adv(0.5 + r));
-                        let e = end(&a1, &a3, 1.0);
+                        let (a2, ar) = (adv(0.5), adv(r));
+                        let a1 = a2.add(&ar.neg(), o.k2).unwrap_or_else(|| adv(0.5 - r));
+                        let a3 = a2.add(&ar, o.k2).unwrap_or_else(|| adv(0.5 + r));
+                        let e = end(&a2, &a2, 1.0);
                         (
                             magnus_from_samples(
                                 &[w(&a1, 0.5 - r), w(&a2, 0.5), w(&a3, 0.5 + r)],
@@ -269,6 +273,15 @@ impl Jacobi {
     fn at(u: f64, k2: f64) -> Self {
         let (s, c, d) = jacobi(u, k2);
         Self { s, c, d }
+    }
+
+    /// The values at `−u`: sn is odd, cn and dn even.
+    fn neg(&self) -> Jacobi {
+        Jacobi {
+            s: -self.s,
+            c: self.c,
+            d: self.d,
+        }
     }
 
     /// The addition theorem (DLMF 22.8.1–3): `(sn, cn, dn)(u + v)` from the values at `u` and

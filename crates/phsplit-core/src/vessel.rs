@@ -142,7 +142,7 @@ impl VesselState {
     }
     /// Whether every component is finite.
     pub fn is_finite(&self) -> bool {
-        self.to_vector().iter().all(|v| v.is_finite())
+        self.to_vector().as_slice().iter().all(|v| v.is_finite())
     }
     /// ZYX Euler angles of the attitude (paper eq. 21).
     pub fn euler(&self) -> Vector3<f64> {
