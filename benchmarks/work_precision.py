@@ -405,13 +405,26 @@ def main() -> int:
         if T == 100.0:
             split = min(v for k, v in best.items() if k[0] in ("phsplit sp2", "phsplit sp4", "phsplit sp6"))
             rk4 = best.get(("phsplit rk4", "-", "core"), math.inf)
-            dop = min(v for k, v in best.items() if k[0] == "scipy DOP853")
-            cv = min([v for k, v in best.items() if k[0].startswith("CVODE")] or [math.inf])
+            def fastest(prefix: str, rhs: str | None) -> float:
+                vals = [v for k, v in best.items() if k[0].startswith(prefix) and (rhs is None or k[2] == rhs)]
+                return min(vals or [math.inf])
+
+            def row(text: str, ratio: float, need: float) -> str:
+                shown = f"{ratio:.2f}×" if ratio < 10 else f"{ratio:.0f}×"
+                return f"| {text} | {shown} | {'yes' if ratio >= need else 'no'} |"
+
             L += ["### Targets at final error 1e-6 on [0, 100] s", "",
+                  "Ratios of times to the same final error, measured in the same run. \"numpy rhs\" is the "
+                  "right-hand side a Python user writes; \"compiled rhs\" is the same field as phsplit's "
+                  "compiled core (`phsplit._core.VectorField`), called from the Python solver.", "",
                   "| target | measured | met |", "|---|---|---|",
-                  f"| fastest splitting ≥ 3× faster than phsplit RK4 | {rk4 / split:.2f}× | {'yes' if rk4 / split >= 3 else 'no'} |",
-                  f"| ≥ 100× faster than scipy DOP853 (best rhs) | {dop / split:.0f}× | {'yes' if dop / split >= 100 else 'no'} |",
-                  f"| ≥ 100× faster than CVODE from Python (best) | {cv / split:.0f}× | {'yes' if cv / split >= 100 else 'no'} |",
+                  row("fastest splitting ≥ 3× faster than phsplit RK4", rk4 / split, 3),
+                  row("≥ 100× faster than scipy DOP853, numpy rhs", fastest("scipy DOP853", "numpy") / split, 100),
+                  row("≥ 100× faster than scipy DOP853, compiled rhs", fastest("scipy DOP853", "core") / split, 100),
+                  row("≥ 100× faster than CVODE (fastest of Adams, BDF), numpy rhs",
+                      fastest("CVODE", "numpy") / split, 100),
+                  row("≥ 100× faster than CVODE (fastest of Adams, BDF), compiled rhs",
+                      fastest("CVODE", "core") / split, 100),
                   ""]
     L += ["## Stability over [0, 3600] s", "",
           "Largest sampled h with the energy below its passivity bound H_n ≤ H_0 + supplied_n at every saved step, "
