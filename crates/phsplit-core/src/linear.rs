@@ -714,16 +714,19 @@ mod tests {
         }
         let z0 =
             SVector::<f64, 10>::from_fn(|i, _| if i == 9 { 1.0 } else { (i as f64 * 0.7).sin() });
-        for h in [0.1, 1.0, 7.0] {
+        // The elimination raises the reduced system to degree 3 in h‖A‖, which costs digits at
+        // long steps: measured 5e-13 relative at h = 50 (h‖A‖ ≈ 75), where the dense solve
+        // agrees with the Padé form to 1e-14. Far below the method's own error there.
+        for (h, tol) in [(0.1, 1e-13), (1.0, 1e-13), (7.0, 1e-13), (50.0, 2e-12)] {
             let check = |z: SVector<f64, 10>, ys: &[SVector<f64, 10>], s: usize| {
                 let (zd, yd, _) = gauss::stages(&a, &z0, h, s).unwrap();
                 assert!(
-                    (z - zd).norm() < 1e-13 * zd.norm(),
+                    (z - zd).norm() < tol * zd.norm(),
                     "s={s} h={h}: {}",
                     (z - zd).norm()
                 );
                 for (y, y2) in ys.iter().zip(&yd) {
-                    assert!((y - y2).norm() < 1e-13 * y2.norm());
+                    assert!((y - y2).norm() < tol * y2.norm());
                 }
             };
             for st in 1..=3 {
