@@ -328,7 +328,6 @@ pub mod gauss {
         let ainv = am.try_inverse().expect("the Gauss matrix is invertible");
         let bv = Vector3::from(tb);
         let d = ainv.transpose() * bv;
-        let eig = am.complex_eigenvalues();
         let at = am.transpose().map(Complex::from);
         // Eigenvectors of 𝒜ᵀ in the leading s×s block; beyond s, the unit vectors.
         let mut tm = Matrix3::<Complex<f64>>::identity();
@@ -341,7 +340,7 @@ pub mod gauss {
                 let x = nalgebra::Matrix2::new(ta[0][0], ta[0][1], ta[1][0], ta[1][1]);
                 x.complex_eigenvalues().iter().copied().collect()
             }
-            _ => eig.iter().copied().collect(),
+            _ => am.complex_eigenvalues().iter().copied().collect(),
         };
         for (k, lam) in lead.iter().enumerate() {
             let mut m = at - Matrix3::<Complex<f64>>::identity() * *lam;

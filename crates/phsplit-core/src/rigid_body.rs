@@ -308,12 +308,23 @@ impl OrbitData {
         Jacobi::at(self.lambda * t, self.k2)
     }
 
-    /// The phase `ν` at the start, `F(φ₀ | k²)` with `φ₀ = atan2(sn ν, cn ν)`: needed only
-    /// where the addition theorem is avoided.
-    fn nu(&self) -> Option<f64> {
-        ellipf(self.start.s.atan2(self.start.c), self.k2)
+    /// `(sn, cn, dn)(λt + ν)` evaluated directly, with the start phase
+    /// `ν = F(φ₀ | k²)`, `φ₀ = atan2(sn ν, cn ν)`: needed only where the addition theorem is
+    /// avoided. `None` if `ν` cannot be computed.
+    fn direct(&self, t: f64) -> Option<Jacobi> {
+        let nu = ellipf(self.start.s.atan2(self.start.c), self.k2)
             .ok()
-            .filter(|v| v.is_finite())
+            .filter(|v| v.is_finite())?;
+        Some(Jacobi::at(self.lambda * t + nu, self.k2))
+    }
+
+    /// The momentum with the given `(sn, cn, dn)` of its phase.
+    fn momentum(&self, j: &Jacobi) -> Vector3<f64> {
+        let mut m = Vector3::zeros();
+        m[self.axes[0]] = self.amp[0] * j.c;
+        m[self.axes[1]] = self.amp[1] * j.s;
+        m[self.axes[2]] = self.amp[2] * j.d;
+        m
     }
 }
 
@@ -341,35 +352,21 @@ impl Orbit {
         let Some(o) = &self.data else {
             return self.m0;
         };
-        let j = match o.start.add(adv, o.k2) {
-            Some(j) => j,
-            None => match o.nu() {
-                Some(nu) => Jacobi::at(o.lambda * t + nu, o.k2),
-                None => return Vector3::from_element(f64::NAN),
-            },
-        };
-        let mut m = Vector3::zeros();
-        m[o.axes[0]] = o.amp[0] * j.c;
-        m[o.axes[1]] = o.amp[1] * j.s;
-        m[o.axes[2]] = o.amp[2] * j.d;
-        m
+        match o.start.add(adv, o.k2).or_else(|| o.direct(t)) {
+            Some(j) => o.momentum(&j),
+            None => Vector3::from_element(f64::NAN),
+        }
     }
 
     /// The momentum at `t` by the direct evaluation `(sn, cn, dn)(λt + ν)`, without the
     /// addition theorem (a cross-check for the tests).
     pub fn momentum_direct(&self, t: f64) -> Vector3<f64> {
-        let Some(o) = &self.data else {
-            return self.m0;
-        };
-        let Some(nu) = o.nu() else {
-            return Vector3::from_element(f64::NAN);
-        };
-        let j = Jacobi::at(o.lambda * t + nu, o.k2);
-        let mut m = Vector3::zeros();
-        m[o.axes[0]] = o.amp[0] * j.c;
-        m[o.axes[1]] = o.amp[1] * j.s;
-        m[o.axes[2]] = o.amp[2] * j.d;
-        m
+        match &self.data {
+            None => self.m0,
+            Some(o) => o
+                .direct(t)
+                .map_or(Vector3::from_element(f64::NAN), |j| o.momentum(&j)),
+        }
     }
 
     /// `k²` of the orbit (`None` for a fixed point).

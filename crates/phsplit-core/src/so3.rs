@@ -117,7 +117,7 @@ pub fn euler_zyx(q: &Matrix3<f64>) -> Vector3<f64> {
     euler_zyx_with(q, rho)
 }
 
-/// [`euler_zyx`] given `rho = |(Q11, Q21)|` (shared with [`pi_e_inv_of`] by [`euler_and_w`]).
+/// [`euler_zyx`] given `rho = |(Q11, Q21)|` (shared with `W` by [`euler_and_w`]).
 /// `atan2` is musl's (the `libm` crate, within 1 ulp).
 fn euler_zyx_with(q: &Matrix3<f64>, rho: f64) -> Vector3<f64> {
     let phi = libm::atan2(q[(2, 1)], q[(2, 2)]);
@@ -128,7 +128,8 @@ fn euler_zyx_with(q: &Matrix3<f64>, rho: f64) -> Vector3<f64> {
 
 /// The ZYX Euler angles of `q` and `W = Pi_e(theta)⁻¹ q` (the controller's map from body
 /// angular velocity to Euler-angle rates), with the trigonometric functions of the angles
-/// read off the entries of `q` as in [`pi_e_inv_of`]. Rows of `W`, with `r_i` the rows of
+/// read off the entries of `q`: `cos ψ = Q11/ρ, sin ψ = Q21/ρ, ρ = |(Q11, Q21)|`,
+/// `cos θ = ρ/r, sin θ = −Q31/r`, `r` = the norm of the first column. Rows of `W`, with `r_i` the rows of
 /// `q`: `W_0 = sec θ (cos ψ r_0 + sin ψ r_1)`, `W_1 = cos ψ r_1 − sin ψ r_0`,
 /// `W_2 = tan θ (cos ψ r_0 + sin ψ r_1) + r_2`.
 pub fn euler_and_w(q: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
@@ -171,19 +172,6 @@ pub fn pi_e_inv(e: &Vector3<f64>) -> Matrix3<f64> {
         sp * st / ct,
         1.0,
     )
-}
-
-/// `Pi_e(theta)⁻¹` at the ZYX angles of `q`, without evaluating them: the sines and cosines of
-/// the `atan2`s of [`euler_zyx`] are ratios of entries of `q`
-/// (`cos ψ = Q11/ρ, sin ψ = Q21/ρ, ρ = hypot(Q11, Q21)`; `cos θ = ρ/r, sin θ = −Q31/r`,
-/// `r = |first column|`). Equals `pi_e_inv(&euler_zyx(q))` to rounding, with no trigonometry.
-pub fn pi_e_inv_of(q: &Matrix3<f64>) -> Matrix3<f64> {
-    let rho = (q[(0, 0)] * q[(0, 0)] + q[(1, 0)] * q[(1, 0)]).sqrt();
-    let r = (rho * rho + q[(2, 0)] * q[(2, 0)]).sqrt();
-    let (cp, sp) = (q[(0, 0)] / rho, q[(1, 0)] / rho);
-    let tt = -q[(2, 0)] / rho; // tan θ
-    let sec = r / rho; // 1 / cos θ
-    Matrix3::new(cp * sec, sp * sec, 0.0, -sp, cp, 0.0, cp * tt, sp * tt, 1.0)
 }
 
 /// Euler–Rodrigues map `E(q) = I + 2 q0 hat(qv) + 2 hat(qv)^2` for a unit quaternion
@@ -323,11 +311,11 @@ mod tests {
         let omega_spatial = vee(&(qd * q.transpose()));
         assert!((pi_e(&e) * ed - omega_spatial).norm() < 1e-9);
         assert!((pi_e(&e) * pi_e_inv(&e) - Matrix3::identity()).norm() < 1e-15);
-        // The trig-free form agrees, also for a matrix that is only nearly orthogonal.
-        assert!((pi_e_inv_of(&q) - pi_e_inv(&e)).norm() < 1e-15);
+        // The trig-free W agrees, also for a matrix that is only nearly orthogonal.
+        assert!((euler_and_w(&q).1 - pi_e_inv(&e) * q).norm() < 1e-15);
         let mut nq = q * 1.001;
         nq[(2, 0)] += 1e-4;
-        assert!((pi_e_inv_of(&nq) - pi_e_inv(&euler_zyx(&nq))).norm() < 1e-14);
+        assert!((euler_and_w(&nq).1 - pi_e_inv(&euler_zyx(&nq)) * nq).norm() < 1e-14);
         // The fused angles-and-W equals its parts, for rotations across the chart and the
         // nearly orthogonal matrix.
         for (i, m) in [

@@ -545,14 +545,7 @@ impl<'a> VesselSystem<'a> {
         let k = if on { 1.0 } else { 0.0 };
         let kv = |a: [f64; 3]| Vector3::from(a) * k;
         let qt = q0.transpose();
-        // Qᵀ diag(g): column j of Qᵀ times g_j.
-        let qt_diag = |g: &Vector3<f64>| {
-            let mut m = qt;
-            for j in 0..3 {
-                m.column_mut(j).scale_mut(g[j]);
-            }
-            m
-        };
+        let qt_diag = |g: &Vector3<f64>| times_diag(&qt, g);
         let c_heave = vsl.heave_stiffness();
         let xr = Vector3::from(c.position_reference);
         // Translation. In the set-point error e = x − x_ref rather than x: the port's quadratic
@@ -578,21 +571,12 @@ impl<'a> VesselSystem<'a> {
         let tinv = vsl.inertia().map(|v| 1.0 / v);
         let wm = f.w_mat;
         let wt = wm.transpose();
-        let wt_diag = |g: &Vector3<f64>| {
-            let mut m = wt;
-            for j in 0..3 {
-                m.column_mut(j).scale_mut(g[j]);
-            }
-            m
-        };
+        let wt_diag = |g: &Vector3<f64>| times_diag(&wt, g);
         let mut d_r = wt_diag(&kv(c.kd_rotational)) * wm;
         for i in 0..3 {
             d_r[(i, i)] += vsl.hull.damping_rotational[i];
         }
-        let mut auu_r = -d_r;
-        for j in 0..3 {
-            auu_r.column_mut(j).scale_mut(tinv[j]);
-        }
+        let auu_r = -times_diag(&d_r, &tinv);
         let hq3 = so3::hat(&f.q3);
         let g = vsl.g_diag();
         let mut avu_r = hq3;
@@ -810,6 +794,15 @@ impl S2Block {
             work,
         )
     }
+}
+
+/// `M diag(g)`: column j of `M` times `g_j` (diagonal gains and inertias as scalings).
+fn times_diag(m: &Matrix3<f64>, g: &Vector3<f64>) -> Matrix3<f64> {
+    let mut out = *m;
+    for j in 0..3 {
+        out.column_mut(j).scale_mut(g[j]);
+    }
+    out
 }
 
 /// Put `B/2` at block (r, c) and `Bᵀ/2` at (c, r), so that `zᵀMz` contains `z_rᵀ B z_c`.
