@@ -12,9 +12,6 @@ pub enum Error {
     /// A scenario or parameter file that cannot be read or parsed.
     #[error("{0}")]
     Parse(String),
-    /// The integration produced a non-finite state; `step` is the first bad step.
-    #[error("integration failed at step {step} (t = {t}): {reason}")]
-    Integration { step: usize, t: f64, reason: String },
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

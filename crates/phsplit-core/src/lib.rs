@@ -3,18 +3,23 @@
 //! Implements E. Celledoni, E. H. Høiseth, N. Ramzina, *Passivity-preserving splitting methods
 //! for rigid body systems*, Multibody System Dynamics 44 (2018) 251–275 (arXiv:1408.2544):
 //! the vessel model of its §3.4, the exact flows of its split (40)/(41), the compositions of its
-//! §2 and explicit Runge–Kutta baselines, with an energy ledger. No Python here; the `phsplit-py`
-//! crate binds it.
+//! §2 and explicit Runge–Kutta baselines, with an energy ledger by port. The model is restated
+//! in the repository's `docs/model.md`. No Python here; the `phsplit-py` crate binds it.
 //!
-//! Modules: [`so3`] (rotations, quaternions, Euler angles), [`elliptic`] (Jacobi sn/cn/dn, K, F),
-//! [`rigid_body`] (exact free rigid body, Magnus attitude), [`linear`] (affine flows, Van Loan
-//! integrals), [`methods`] (methods as data), [`vessel`] (the model), [`integrate`] (the kernels).
-pub mod elliptic;
+//! Layout:
+//! - [`lie`]: rotations, quaternions, Euler angles ([`lie::so3`]); Jacobi sn/cn/dn, K, F
+//!   ([`lie::elliptic`]).
+//! - [`flows`]: the free rigid body ([`flows::rigid_body`]), affine flows and Van Loan
+//!   integrals ([`flows::affine`]), Gauss collocation ([`flows::collocation`]).
+//! - [`methods`]: compositions and Butcher tableaus as data, one registry.
+//! - [`solve`]: kernels, options, trajectories and the ledger; the traits a model implements.
+//! - [`model`]: the vessel: parameters, state, system, and its forces as components.
+//! - [`settings`]: a run's settings, parsed and validated once.
 pub mod error;
-pub mod integrate;
-pub mod linear;
+pub mod flows;
+pub mod lie;
 pub mod methods;
-pub mod rigid_body;
-pub mod so3;
-pub mod vessel;
+pub mod model;
+pub mod settings;
+pub mod solve;
 pub use error::{Error, Result};

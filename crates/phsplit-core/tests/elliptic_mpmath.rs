@@ -7,7 +7,7 @@
 //! argument: a function of slope ≤ 1 (sn, cn, dn, and the amplitude inside them) evaluated at
 //! `x(1 ± ε)` moves by up to `|x| ε`; `δ` is 1 for sn/cn/dn and 0 for K and F, whose values are
 //! bounded away from zero except at x = 0 (where both are exact).
-use phsplit_core::elliptic::{ellipf, ellipk, jacobi};
+use phsplit_core::lie::elliptic::{ellipf, ellipk, jacobi};
 
 struct Row {
     f: String,

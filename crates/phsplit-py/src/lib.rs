@@ -1,22 +1,25 @@
 //! `phsplit._core`: the thin PyO3 layer over `phsplit-core`.
 //!
-//! One error conversion (core `Error` → a Python exception class per variant), newtype
-//! `#[pyclass]` wrappers, numpy arrays out, and the GIL released around every integration.
-//! Nothing here panics across the boundary: every fallible call returns `PyResult`.
+//! It converts values (Python mappings to TOML tables, numpy arrays out), maps the core's
+//! errors to Python exceptions, and releases the GIL around every integration. Every option
+//! and parameter is parsed and validated by the core. Nothing here panics across the
+//! boundary: every fallible call returns `PyResult`, and a panic in the core is caught.
 
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
-use phsplit_core::integrate::{run, Options, Status};
-use phsplit_core::methods::{Method, Outer, METHOD_NAMES};
-use phsplit_core::so3;
-use phsplit_core::vessel::{
+use phsplit_core::lie::so3;
+use phsplit_core::methods::{self, Method};
+use phsplit_core::model::vessel::{
     LinearFlow, Vessel, VesselState, VesselSystem, PAPER_VESSEL_TOML, STATE_DIM,
 };
+use phsplit_core::settings::{Settings, KEYS};
+use phsplit_core::solve::{run, AccountKind, Status};
 use phsplit_core::Error;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use toml::{Table, Value};
 
 create_exception!(
     _core,
@@ -48,35 +51,117 @@ fn to_py(e: Error) -> PyErr {
         Error::InvalidInput(m) => InvalidInputError::new_err(m),
         Error::Parse(m) => ScenarioParseError::new_err(m),
         Error::Domain(m) => IntegrationError::new_err(m),
-        e @ Error::Integration { .. } => IntegrationError::new_err(e.to_string()),
     }
 }
 
-/// A vessel: hull data, PID controller and default initial state (SI units).
+/// A Python value as TOML (mappings, sequences, bool, int, float, str); `path` names it in
+/// the error.
+fn to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
+    if obj.is_instance_of::<PyBool>() {
+        return Ok(Value::Boolean(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyInt>() {
+        return match obj.extract::<i64>() {
+            Ok(i) => Ok(Value::Integer(i)),
+            Err(_) => Ok(Value::Float(obj.extract()?)),
+        };
+    }
+    if obj.is_instance_of::<PyFloat>() {
+        return Ok(Value::Float(obj.extract()?));
+    }
+    if obj.is_instance_of::<PyString>() {
+        return Ok(Value::String(obj.extract()?));
+    }
+    if let Ok(d) = obj.cast::<PyDict>() {
+        return Ok(Value::Table(to_table(d, path)?));
+    }
+    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() || obj.hasattr("__array__")? {
+        // numpy scalars have __array__ too: a 0-d array is a number.
+        if let Ok(x) = obj.extract::<f64>() {
+            if !obj.is_instance_of::<PyList>() && !obj.is_instance_of::<PyTuple>() {
+                return Ok(Value::Float(x));
+            }
+        }
+        let items: Vec<Bound<'_, PyAny>> = obj.try_iter()?.collect::<PyResult<_>>()?;
+        return Ok(Value::Array(
+            items
+                .iter()
+                .enumerate()
+                .map(|(i, v)| to_toml(v, &format!("{path}[{i}]")))
+                .collect::<PyResult<_>>()?,
+        ));
+    }
+    Err(InvalidInputError::new_err(format!(
+        "{path} must be a number, a string, a boolean, a sequence or a mapping, got {}",
+        obj.get_type().name()?
+    )))
+}
+
+fn to_table(d: &Bound<'_, PyDict>, path: &str) -> PyResult<Table> {
+    let mut t = Table::new();
+    for (k, v) in d.iter() {
+        let key: String = k
+            .extract()
+            .map_err(|_| InvalidInputError::new_err(format!("the keys of {path} must be strings")))?;
+        let sub = if path.is_empty() { key.clone() } else { format!("{path}.{key}") };
+        t.insert(key, to_toml(&v, &sub)?);
+    }
+    Ok(t)
+}
+
+/// A TOML value as Python (tables → dict, arrays → list).
+fn from_toml<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        Value::String(s) => s.into_pyobject(py)?.into_any(),
+        Value::Integer(i) => i.into_pyobject(py)?.into_any(),
+        Value::Float(f) => f.into_pyobject(py)?.into_any(),
+        Value::Boolean(b) => PyBool::new(py, *b).to_owned().into_any(),
+        Value::Array(a) => {
+            let l = PyList::empty(py);
+            for x in a {
+                l.append(from_toml(py, x)?)?;
+            }
+            l.into_any()
+        }
+        Value::Table(t) => {
+            let d = PyDict::new(py);
+            for (k, x) in t {
+                d.set_item(k, from_toml(py, x)?)?;
+            }
+            d.into_any()
+        }
+        Value::Datetime(d) => d.to_string().into_pyobject(py)?.into_any(),
+    })
+}
+
+/// A vessel: rigid body, forces and ports, and default initial state (SI units).
 #[pyclass(name = "Vessel", module = "phsplit._core", frozen)]
 #[derive(Clone)]
 struct PyVessel {
     inner: Vessel,
 }
 
-fn v3(a: [f64; 3]) -> [f64; 3] {
-    a
-}
-
 #[pymethods]
 impl PyVessel {
-    /// The paper's vessel and scenario (Appendix D as reconstructed in MODEL.md §3).
+    /// The paper's vessel and scenario (Appendix D; docs/model.md §4).
     #[staticmethod]
     fn paper() -> Self {
         Self {
             inner: Vessel::paper(),
         }
     }
-    /// Parse a vessel from TOML text with sections [vessel], [control], [initial].
+    /// Parse a vessel from TOML text: [vessel], [control], [initial] and optional components.
     #[staticmethod]
     fn from_toml_str(text: &str) -> PyResult<Self> {
         Ok(Self {
             inner: Vessel::from_toml_str(text).map_err(to_py)?,
+        })
+    }
+    /// Build a vessel from a mapping with the tables of a vessel file.
+    #[staticmethod]
+    fn from_dict(d: &Bound<'_, PyDict>) -> PyResult<Self> {
+        Ok(Self {
+            inner: Vessel::from_table(to_table(d, "")?).map_err(to_py)?,
         })
     }
     /// The TOML text of the paper's vessel, with its provenance.
@@ -84,47 +169,30 @@ impl PyVessel {
     fn paper_toml() -> &'static str {
         PAPER_VESSEL_TOML
     }
-    /// All parameters as a nested dict (SI units).
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let v = &self.inner;
-        let hull = PyDict::new(py);
-        hull.set_item("mass", v.hull.mass)?;
-        hull.set_item("inertia", v3(v.hull.inertia))?;
-        hull.set_item("damping_translational", v.hull.damping_translational)?;
-        hull.set_item("damping_rotational", v.hull.damping_rotational)?;
-        hull.set_item("gm_transverse", v.hull.gm_transverse)?;
-        hull.set_item("gm_longitudinal", v.hull.gm_longitudinal)?;
-        hull.set_item("gravity", v.hull.gravity)?;
-        hull.set_item("water_density", v.hull.water_density)?;
-        hull.set_item("waterplane_area", v.hull.waterplane_area)?;
-        let c = &v.control;
-        let control = PyDict::new(py);
-        control.set_item("kp_translational", c.kp_translational)?;
-        control.set_item("kd_translational", c.kd_translational)?;
-        control.set_item("ki_translational", c.ki_translational)?;
-        control.set_item("kp_rotational", c.kp_rotational)?;
-        control.set_item("kd_rotational", c.kd_rotational)?;
-        control.set_item("ki_rotational", c.ki_rotational)?;
-        control.set_item("euler_reference", c.euler_reference)?;
-        control.set_item("position_reference", c.position_reference)?;
-        let i = &v.initial;
-        let initial = PyDict::new(py);
-        initial.set_item("euler", i.euler)?;
-        initial.set_item("position", i.position)?;
-        initial.set_item("velocity", i.velocity)?;
-        initial.set_item("angular_velocity", i.angular_velocity)?;
-        let d = PyDict::new(py);
-        d.set_item("vessel", hull)?;
-        d.set_item("control", control)?;
-        d.set_item("initial", initial)?;
-        Ok(d)
+    /// Every parameter as read (defaults filled in), as a nested dict (SI units).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        from_toml(py, &Value::Table(self.inner.params.clone()))
+    }
+    /// The names of the vessel's components, in the order they are assembled.
+    fn components(&self) -> Vec<&'static str> {
+        self.inner.forces.iter().map(|f| f.name()).collect()
+    }
+    /// The ledger's accounts: (name, "supplied" or "dissipated") per account.
+    fn accounts(&self) -> Vec<(&'static str, &'static str)> {
+        use phsplit_core::solve::Model;
+        VesselSystem::new(&self.inner, None)
+            .accounts()
+            .iter()
+            .map(|a| (a.name, kind_name(a.kind)))
+            .collect()
     }
     /// The stored energy H of eq. (35) at a flat 27-vector state (J).
     fn energy(&self, state: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
-        Ok(self.inner.energy(&flat_state(&state)?))
+        let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;
+        Ok(self.inner.energy(&s))
     }
     /// The initial state as a flat 27-vector (p, m, Q column-major, mu, x, phi_th, phi_x),
-    /// from engineering variables (defaults: the file's [initial] section).
+    /// from engineering variables (defaults: the file's [initial] table).
     #[pyo3(signature = (euler=None, position=None, velocity=None, angular_velocity=None))]
     fn initial_state<'py>(
         &self,
@@ -139,11 +207,7 @@ impl PyVessel {
             ("euler", euler.unwrap_or(i.euler), "rad"),
             ("position", position.unwrap_or(i.position), "m"),
             ("velocity", velocity.unwrap_or(i.velocity), "m/s"),
-            (
-                "angular_velocity",
-                angular_velocity.unwrap_or(i.angular_velocity),
-                "rad/s",
-            ),
+            ("angular_velocity", angular_velocity.unwrap_or(i.angular_velocity), "rad/s"),
         ];
         for (name, v, unit) in &all {
             if v.iter().any(|x| !x.is_finite()) {
@@ -162,9 +226,18 @@ impl PyVessel {
     }
     fn __repr__(&self) -> String {
         format!(
-            "Vessel(mass={:.6e} kg, inertia={:?} kg m^2)",
-            self.inner.hull.mass, self.inner.hull.inertia
+            "Vessel(mass={:.6e} kg, inertia={:?} kg m^2, components={:?})",
+            self.inner.body.mass,
+            self.inner.body.inertia.as_slice(),
+            self.components()
         )
+    }
+}
+
+fn kind_name(k: AccountKind) -> &'static str {
+    match k {
+        AccountKind::Supplied => "supplied",
+        AccountKind::Dissipated => "dissipated",
     }
 }
 
@@ -173,130 +246,111 @@ fn entries(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
     a.as_array().iter().copied().collect()
 }
 
-fn flat_state(a: &PyReadonlyArray1<'_, f64>) -> PyResult<VesselState> {
-    let s = &entries(a)[..];
-    if s.len() != STATE_DIM {
-        return Err(InvalidInputError::new_err(format!(
-            "a state is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x), got {}",
-            s.len()
-        )));
-    }
-    if s.iter().any(|v| !v.is_finite()) {
-        return Err(InvalidInputError::new_err(
-            "the initial state must be finite",
-        ));
-    }
-    Ok(VesselState::from_vector(
-        &nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(s),
-    ))
+/// Settings from a mapping over the defaults. With `api`, a value of the wrong type is an
+/// InvalidInputError (a function argument) and names the argument; otherwise a
+/// ScenarioParseError naming `simulation.<key>` (a file).
+fn settings_of(d: &Bound<'_, PyDict>, api: bool) -> PyResult<(Settings, Option<String>)> {
+    let t = to_table(d, if api { "" } else { "simulation" })?;
+    Settings::from_table(&t).map_err(|e| match (api, e) {
+        (true, Error::Parse(m)) | (true, Error::InvalidInput(m)) => {
+            InvalidInputError::new_err(m.replacen("simulation.", "", 1))
+        }
+        (_, e) => to_py(e),
+    })
 }
 
-/// Metadata of a method: order, stages, citation, all_positive, kind.
+fn settings_dict<'py>(py: Python<'py>, s: &Settings, name: Option<String>) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("t_span", (s.t_span.0, s.t_span.1))?;
+    d.set_item("h", s.h)?;
+    d.set_item("method", s.method.name())?;
+    d.set_item("control_start", s.control_start)?;
+    d.set_item("outer", s.outer.name())?;
+    d.set_item("save_every", s.save_every)?;
+    d.set_item("linear_flow", s.linear_flow.name())?;
+    d.set_item("ledger", s.ledger)?;
+    d.set_item("n_steps", s.n_steps().ok())?;
+    if let Some(n) = name {
+        d.set_item("name", n)?;
+    }
+    Ok(d)
+}
+
+/// The default settings of a run (the paper's Fig. 2), as a dict.
+#[pyfunction]
+fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    settings_dict(py, &Settings::default(), None)
+}
+
+/// Parse and validate settings given as a mapping over the defaults; returns them complete,
+/// with the step count. `api=False` reads a scenario file's [simulation] table.
+#[pyfunction]
+#[pyo3(signature = (d, api=true))]
+fn check_settings<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, api: bool) -> PyResult<Bound<'py, PyDict>> {
+    let (s, name) = settings_of(d, api)?;
+    settings_dict(py, &s, name)
+}
+
+/// The keys of a [simulation] table with what each takes.
+#[pyfunction]
+fn settings_keys() -> Vec<(&'static str, &'static str)> {
+    KEYS.to_vec()
+}
+
+/// Metadata of a method: name, kind, order, stages, citation, all_positive, subflow_order and
+/// the Prop. 2.5 bounds of a splitting.
 #[pyfunction]
 fn method_info<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>> {
-    let m = Method::by_name(name).map_err(to_py)?;
+    let m: Method = name.parse().map_err(to_py)?;
     let d = PyDict::new(py);
     d.set_item("name", m.name())?;
     d.set_item("order", m.order())?;
     d.set_item("stages", m.stages())?;
     d.set_item("citation", m.citation())?;
     d.set_item("all_positive", m.all_positive())?;
-    d.set_item(
-        "kind",
-        match m {
-            Method::Splitting(_) => "splitting",
-            Method::RungeKutta(_) => "runge-kutta",
-        },
-    )?;
+    d.set_item("kind", m.kind())?;
+    d.set_item("subflow_order", m.subflow_order())?;
     if let Method::Splitting(c) = &m {
-        d.set_item(
-            "dissipation_ratio_bound_outer",
-            c.dissipation_ratio_bound(true),
-        )?;
-        d.set_item(
-            "dissipation_ratio_bound_inner",
-            c.dissipation_ratio_bound(false),
-        )?;
+        d.set_item("dissipation_ratio_bound_outer", c.dissipation_ratio_bound(true))?;
+        d.set_item("dissipation_ratio_bound_inner", c.dissipation_ratio_bound(false))?;
     }
     Ok(d)
 }
 
-/// Integrate; returns a dict of numpy arrays. The GIL is released while integrating.
+/// Integrate with the given settings (a mapping over the defaults) from `state0` (a flat
+/// 27-vector; None: the vessel's initial state); returns a dict of numpy arrays. The GIL is
+/// released while integrating.
 #[pyfunction]
-#[pyo3(signature = (vessel, t0, h, n_steps, method, control_start, outer, save_every, ledger, state0, linear_flow="exact", orthonormalize=false))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false))]
 fn integrate<'py>(
     py: Python<'py>,
     vessel: &PyVessel,
-    t0: f64,
-    h: f64,
-    n_steps: usize,
-    method: &str,
-    control_start: Option<f64>,
-    outer: &str,
-    save_every: usize,
-    ledger: bool,
-    state0: PyReadonlyArray1<'_, f64>,
-    linear_flow: &str,
+    settings: &Bound<'py, PyDict>,
+    state0: Option<PyReadonlyArray1<'_, f64>>,
     orthonormalize: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let method = Method::by_name(method).map_err(to_py)?;
-    let linear = match linear_flow {
-        "exact" => LinearFlow::Exact,
-        "gauss" => LinearFlow::Gauss,
-        other => {
-            return Err(InvalidInputError::new_err(format!(
-                "linear_flow must be 'exact' (matrix exponential) or 'gauss' (Gauss collocation / diagonal Padé), got {other:?}"
-            )))
-        }
-    };
-    let order = method.order();
-    let outer = match outer {
-        "dissipative" | "S2" | "s2" => Outer::Dissipative,
-        "conservative" | "S1" | "s1" => Outer::Conservative,
-        other => {
-            return Err(InvalidInputError::new_err(format!(
-                "outer must be 'dissipative' (S2 outermost) or 'conservative' (S1 outermost), got {other:?}"
-            )))
-        }
-    };
-    if let Some(tc) = control_start {
-        if !tc.is_finite() {
-            return Err(InvalidInputError::new_err(format!(
-                "control_start must be finite (s) or None, got {tc}"
-            )));
-        }
-    }
-    let mut y0 = flat_state(&state0)?;
-    if orthonormalize {
-        y0.q = so3::orthonormalize(&y0.q);
-        if !y0.q.iter().all(|v| v.is_finite()) {
-            return Err(InvalidInputError::new_err(
-                "the initial attitude Q cannot be projected to a rotation (it is zero or not finite)",
-            ));
-        }
-    } else if so3::orthogonality_defect(&y0.q) > 1e-9 || y0.q.determinant() < 0.0 {
-        return Err(InvalidInputError::new_err(format!(
-            "the initial attitude Q is not a rotation: ‖QᵀQ − I‖ = {:.3e}, det Q = {:.6} (allowed: ‖QᵀQ − I‖ ≤ 1e-9, det Q = 1); pass orthonormalize=True to project it to the nearest rotation",
-            so3::orthogonality_defect(&y0.q),
-            y0.q.determinant()
-        )));
-    }
-    let opts = Options {
-        t0,
-        h,
-        n_steps,
-        save_every,
-        outer,
-        ledger,
+    let (settings, _) = settings_of(settings, true)?;
+    let opts = settings.options().map_err(to_py)?;
+    let y0 = match &state0 {
+        None => vessel.inner.initial_state(),
+        Some(a) => VesselState::from_slice_checked(&entries(a), orthonormalize).map_err(to_py)?,
     };
     let v = vessel.inner.clone();
+    let s2 = settings.clone();
     // A panic in the core (a bug) reaches Python as a PhsplitError, never an abort.
-    let traj = py
+    let out = py
         .detach(move || {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                let sys = VesselSystem::new(&v, control_start).with_linear_flow(linear, order);
-                run(&sys, &method, y0, &opts)
+                let sys = VesselSystem::new(&v, s2.control_start).with_linear_flow(s2.linear_flow);
+                let traj = run(&sys, &s2.method, y0, &opts)?;
+                // The force and moment of each account at the saved states.
+                let wrenches: Vec<_> = traj
+                    .t
+                    .iter()
+                    .zip(&traj.states)
+                    .map(|(t, s)| sys.account_wrenches(s, sys.control_on(*t)))
+                    .collect();
+                Ok::<_, Error>((traj, wrenches))
             }))
         })
         .map_err(|p| {
@@ -308,7 +362,9 @@ fn integrate<'py>(
             PhsplitError::new_err(format!("internal error in the phsplit core: {msg}"))
         })?
         .map_err(to_py)?;
+    let (traj, wrenches) = out;
     let n = traj.t.len();
+    let k = traj.accounts.len();
     let mut cols: [Vec<f64>; 8] = Default::default();
     let mut qmat = Vec::with_capacity(9 * n);
     let mut quat = Vec::with_capacity(4 * n);
@@ -325,34 +381,41 @@ fn integrate<'py>(
                 qmat.push(s.q[(i, j)]);
             }
         }
-        let q = so3::quaternion(&s.q);
-        quat.extend_from_slice(q.as_slice());
+        quat.extend_from_slice(so3::quaternion(&s.q).as_slice());
         cols[7].push(so3::orthogonality_defect(&s.q));
     }
     let d = PyDict::new(py);
     let arr3 = |v: &Vec<f64>| PyArray1::from_slice(py, v).reshape([n, 3]);
     d.set_item("t", PyArray1::from_vec(py, traj.t.clone()))?;
-    for (k, name) in ["p", "m", "mu", "x", "phi_th", "phi_x", "euler"]
-        .iter()
-        .enumerate()
-    {
-        d.set_item(*name, arr3(&cols[k])?)?;
+    for (i, name) in ["p", "m", "mu", "x", "phi_th", "phi_x", "euler"].iter().enumerate() {
+        d.set_item(*name, arr3(&cols[i])?)?;
     }
-    d.set_item(
-        "orthogonality_defect",
-        PyArray1::from_vec(py, cols[7].clone()),
-    )?;
+    d.set_item("orthogonality_defect", PyArray1::from_vec(py, cols[7].clone()))?;
     d.set_item("Q", PyArray1::from_vec(py, qmat).reshape([n, 3, 3])?)?;
     d.set_item("quaternion", PyArray1::from_vec(py, quat).reshape([n, 4])?)?;
-    d.set_item("energy", PyArray1::from_vec(py, traj.energy))?;
-    d.set_item("supplied", PyArray1::from_vec(py, traj.supplied))?;
-    d.set_item("dissipated", PyArray1::from_vec(py, traj.dissipated))?;
+    d.set_item("energy", PyArray1::from_vec(py, traj.energy.clone()))?;
+    d.set_item("supplied", PyArray1::from_vec(py, traj.supplied.clone()))?;
+    d.set_item("dissipated", PyArray1::from_vec(py, traj.dissipated.clone()))?;
+    let names: Vec<&str> = traj.accounts.iter().map(|a| a.name).collect();
+    let kinds: Vec<&str> = traj.accounts.iter().map(|a| kind_name(a.kind)).collect();
+    d.set_item("accounts", names)?;
+    d.set_item("account_kinds", kinds)?;
+    let booked: Vec<f64> = traj.booked.iter().flat_map(|w| w.0[..k].to_vec()).collect();
+    d.set_item("booked", PyArray1::from_vec(py, booked).reshape([n, k])?)?;
+    let mut force = Vec::with_capacity(n * k * 3);
+    let mut moment = Vec::with_capacity(n * k * 3);
+    for w in &wrenches {
+        for (f, m) in w {
+            force.extend_from_slice(f.as_slice());
+            moment.extend_from_slice(m.as_slice());
+        }
+    }
+    d.set_item("account_force", PyArray1::from_vec(py, force).reshape([n, k, 3])?)?;
+    d.set_item("account_moment", PyArray1::from_vec(py, moment).reshape([n, k, 3])?)?;
     d.set_item("steps", traj.steps)?;
-    d.set_item(
-        "last_good",
-        PyArray1::from_slice(py, traj.last_good.to_vector().as_slice()),
-    )?;
+    d.set_item("last_good", PyArray1::from_slice(py, traj.last_good.to_vector().as_slice()))?;
     d.set_item("t_last_good", traj.t_last_good)?;
+    d.set_item("settings", settings_dict(py, &settings, None)?)?;
     match traj.status {
         Status::Completed => d.set_item("status", "completed")?,
         Status::Failed { step, t, reason } => {
@@ -388,9 +451,7 @@ impl PyVectorField {
         t: f64,
         y: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let s = state_any(&y)?;
-        let sys = VesselSystem::new(&self.vessel, self.control_start);
-        let d = sys.vector_field(&s, sys.control_on(t)).to_vector();
+        let d = self.field(t, &y)?;
         Ok(PyArray1::from_slice(py, d.as_slice()))
     }
     /// `f(t, y)` written into `out` (the CVODE calling convention `f(t, y, yp)`).
@@ -400,9 +461,7 @@ impl PyVectorField {
         y: PyReadonlyArray1<'_, f64>,
         mut out: numpy::PyReadwriteArray1<'_, f64>,
     ) -> PyResult<()> {
-        let s = state_any(&y)?;
-        let sys = VesselSystem::new(&self.vessel, self.control_start);
-        let d = sys.vector_field(&s, sys.control_on(t)).to_vector();
+        let d = self.field(t, &y)?;
         let o = out
             .as_slice_mut()
             .map_err(|e| InvalidInputError::new_err(e.to_string()))?;
@@ -417,18 +476,20 @@ impl PyVectorField {
     }
 }
 
-/// A 27-vector state without the finiteness check (solvers probe freely).
-fn state_any(a: &PyReadonlyArray1<'_, f64>) -> PyResult<VesselState> {
-    let s = &entries(a)[..];
-    if s.len() != STATE_DIM {
-        return Err(InvalidInputError::new_err(format!(
-            "a state is a flat vector of {STATE_DIM} numbers, got {}",
-            s.len()
-        )));
+impl PyVectorField {
+    /// The field at a 27-vector, without the finiteness check (solvers probe freely).
+    fn field(&self, t: f64, y: &PyReadonlyArray1<'_, f64>) -> PyResult<nalgebra::SVector<f64, STATE_DIM>> {
+        let s = entries(y);
+        if s.len() != STATE_DIM {
+            return Err(InvalidInputError::new_err(format!(
+                "a state is a flat vector of {STATE_DIM} numbers, got {}",
+                s.len()
+            )));
+        }
+        let s = VesselState::from_vector(&nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(&s));
+        let sys = VesselSystem::new(&self.vessel, self.control_start);
+        Ok(sys.vector_field(&s, sys.control_on(t)).to_vector())
     }
-    Ok(VesselState::from_vector(
-        &nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(s),
-    ))
 }
 
 /// Euler angles (ZYX: roll, pitch, yaw) of a 3×3 attitude matrix, eq. (21).
@@ -439,6 +500,12 @@ fn euler_zyx(q: [[f64; 3]; 3]) -> [f64; 3] {
     [e.x, e.y, e.z]
 }
 
+/// The tables a vessel file may have (the components' and the vessel's own).
+#[pyfunction]
+fn vessel_tables() -> Vec<&'static str> {
+    Vessel::tables()
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyVessel>()?;
@@ -446,14 +513,18 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(integrate, m)?)?;
     m.add_function(wrap_pyfunction!(method_info, m)?)?;
     m.add_function(wrap_pyfunction!(euler_zyx, m)?)?;
-    m.add("METHODS", METHOD_NAMES.to_vec())?;
-    m.add("MAX_STEPS", phsplit_core::integrate::MAX_STEPS)?;
+    m.add_function(wrap_pyfunction!(default_settings, m)?)?;
+    m.add_function(wrap_pyfunction!(check_settings, m)?)?;
+    m.add_function(wrap_pyfunction!(settings_keys, m)?)?;
+    m.add_function(wrap_pyfunction!(vessel_tables, m)?)?;
+    m.add("METHODS", methods::names())?;
+    m.add("OUTER", methods::composition::OUTER_NAMES.to_vec())?;
+    m.add("LINEAR_FLOWS", vec![LinearFlow::Exact.name(), LinearFlow::Gauss.name()])?;
+    m.add("MAX_STEPS", phsplit_core::solve::MAX_STEPS)?;
+    m.add("STATE_DIM", STATE_DIM)?;
     m.add("PhsplitError", m.py().get_type::<PhsplitError>())?;
     m.add("InvalidInputError", m.py().get_type::<InvalidInputError>())?;
-    m.add(
-        "ScenarioParseError",
-        m.py().get_type::<ScenarioParseError>(),
-    )?;
+    m.add("ScenarioParseError", m.py().get_type::<ScenarioParseError>())?;
     m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -150,7 +150,7 @@ pub fn euler_and_w(q: &Matrix3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
 }
 
 /// `Pi_e(theta)`: maps ZYX Euler-angle rates to the spatial angular velocity,
-/// `Q w = Pi_e(theta) theta'` (paper, §3 and MODEL.md §2).
+/// `Q w = Pi_e(theta) theta'` (paper §3; docs/model.md §2).
 pub fn pi_e(e: &Vector3<f64>) -> Matrix3<f64> {
     let (st, ct) = e.y.sin_cos();
     let (sp, cp) = e.z.sin_cos();

@@ -25,12 +25,12 @@
 //! Rotations about a principal axis, zero momentum and the sphere are fixed points.
 //!
 //! **Attitude** by Magnus expansions of order 2, 4, 6 in the right-multiplied form (paper
-//! §3.4.1 with the signs of MODEL.md §2: for `Q' = Q A(t)` every even-degree commutator term
+//! §3.4.1 with the signs of docs/model.md §3: for `Q' = Q A(t)` every even-degree commutator term
 //! changes sign relative to the printed `Y' = A(t) Y` formulas).
 
-use crate::elliptic::{ellipf, jacobi};
+use crate::lie::elliptic::{ellipf, jacobi};
 use crate::error::{Error, Result};
-use crate::so3;
+use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
 
 /// Order of the Magnus expansion used for the attitude of the free rigid body.
@@ -50,12 +50,13 @@ impl MagnusOrder {
             MagnusOrder::Six => 6,
         }
     }
-    /// The lowest Magnus order that is at least `p` (capped at 6).
-    pub fn at_least(p: usize) -> Self {
+    /// The lowest Magnus order that is at least `p`; `None` above 6, the highest provided.
+    pub fn for_order(p: usize) -> Option<Self> {
         match p {
-            0..=2 => MagnusOrder::Two,
-            3..=4 => MagnusOrder::Four,
-            _ => MagnusOrder::Six,
+            0..=2 => Some(MagnusOrder::Two),
+            3..=4 => Some(MagnusOrder::Four),
+            5..=6 => Some(MagnusOrder::Six),
+            _ => None,
         }
     }
 }
@@ -102,11 +103,6 @@ impl FreeRigidBody {
     /// Kinetic energy `½ mᵀ T⁻¹ m`.
     pub fn kinetic_energy(&self, m: &Vector3<f64>) -> f64 {
         0.5 * m.dot(&self.omega(m))
-    }
-
-    /// Right-hand side of Euler's equations, `m × T⁻¹m`.
-    pub fn euler_rhs(&self, m: &Vector3<f64>) -> Vector3<f64> {
-        m.cross(&self.omega(m))
     }
 
     /// The exact momentum orbit through `m0`: evaluate it at any time with [`Orbit::momentum`].
@@ -285,13 +281,25 @@ impl Jacobi {
     }
 
     /// The addition theorem (DLMF 22.8.1–3): `(sn, cn, dn)(u + v)` from the values at `u` and
-    /// `v`, with the common denominator `1 − k² sn²u sn²v`. `None` when that denominator is
+    /// `v`, with the common denominator `1 − k² sn²u sn²v` (evaluated as `cn²v + sn²v dn²u`).
+    /// `None` when that denominator is
     /// below 1/2 (near the separatrix, with both arguments near a quarter period), where it
     /// would cost digits: the caller then evaluates directly. `dn` is recomputed as
     /// `sqrt(k₁² + k² cn²)`, as in [`jacobi`], to keep its relative accuracy as `k² → 1`.
     fn add(&self, o: &Jacobi, k2: f64) -> Option<Jacobi> {
-        let den = 1.0 - k2 * (self.s * o.s) * (self.s * o.s);
-        if !(den >= 0.5) {
+        self.add_above(o, k2, 0.5)
+    }
+
+    /// [`Self::add`] with any positive denominator: the last resort where the direct
+    /// evaluation has no finite phase (a start on the separatrix within round-off of the
+    /// unstable middle axis, `sn ν = ±1` with `k² = 1`: `ν = F(π/2 | 1)` is infinite). The
+    /// algebra is exact; its cost in digits is bounded by the size of the denominator,
+    /// `sech²(λt)` there, which is far from zero for any step a simulation takes.
+    fn add_above(&self, o: &Jacobi, k2: f64, min_den: f64) -> Option<Jacobi> {
+        // 1 − k² sn²u sn²v = cn²v + sn²v dn²u: a sum of non-negative terms, free of the
+        // cancellation of the first form next to the separatrix.
+        let den = o.c * o.c + (o.s * o.s) * (self.d * self.d);
+        if !(den >= min_den && den > 0.0) {
             return None;
         }
         let inv = 1.0 / den;
@@ -352,7 +360,8 @@ impl Orbit {
         let Some(o) = &self.data else {
             return self.m0;
         };
-        match o.start.add(adv, o.k2).or_else(|| o.direct(t)) {
+        let j = o.start.add(adv, o.k2).or_else(|| o.direct(t));
+        match j.or_else(|| o.start.add_above(adv, o.k2, f64::MIN_POSITIVE)) {
             Some(j) => o.momentum(&j),
             None => Vector3::from_element(f64::NAN),
         }
@@ -377,30 +386,14 @@ impl Orbit {
     /// Period of the momentum, `4K(k²)/|λ|` (infinite on the separatrix, `None` at a fixed point).
     pub fn period(&self) -> Option<f64> {
         self.data
-            .map(|o| 4.0 * crate::elliptic::ellipk(o.k2).unwrap_or(f64::INFINITY) / o.lambda.abs())
+            .map(|o| 4.0 * crate::lie::elliptic::ellipk(o.k2).unwrap_or(f64::INFINITY) / o.lambda.abs())
     }
 }
 
 /// Magnus exponent `Ω` (as a vector, `Q(h) = Q0 exp(hat Ω)`) for `Q' = Q hat(w(t))` over
-/// `[0, h]`, from samples of `w` at Gauss–Legendre nodes (paper §3.4.1; MODEL.md §2 signs).
-///
-/// Commutators of `hat` matrices are cross products: `[hat a, hat b] = hat(a × b)`.
-pub fn magnus_omega<F: Fn(f64) -> Vector3<f64>>(w: F, h: f64, order: MagnusOrder) -> Vector3<f64> {
-    match order {
-        MagnusOrder::Two => magnus_from_samples(&[w(0.5 * h)], h, order),
-        MagnusOrder::Four => {
-            let r = 3f64.sqrt() / 6.0;
-            magnus_from_samples(&[w((0.5 - r) * h), w((0.5 + r) * h)], h, order)
-        }
-        MagnusOrder::Six => {
-            let r = 15f64.sqrt() / 10.0;
-            magnus_from_samples(&[w((0.5 - r) * h), w(0.5 * h), w((0.5 + r) * h)], h, order)
-        }
-    }
-}
-
-/// [`magnus_omega`] from the samples `w(c_i h)` at the 1, 2 or 3 Gauss–Legendre nodes of
-/// the order.
+/// `[0, h]`, from the samples `w(c_i h)` at the 1, 2 or 3 Gauss–Legendre nodes of the order
+/// (paper §3.4.1; docs/model.md §3 signs). Commutators of `hat` matrices are cross products:
+/// `[hat a, hat b] = hat(a × b)`.
 pub fn magnus_from_samples(w: &[Vector3<f64>], h: f64, order: MagnusOrder) -> Vector3<f64> {
     match order {
         MagnusOrder::Two => w[0] * h,
@@ -702,6 +695,27 @@ mod tests {
             }
             // Q m is conserved by the exact flow; Magnus-6 with h = 0.1 keeps it to ~1e-9.
             prop_assert!((q * m - m0).norm() < 1e-8 * m0.norm().max(1e-3));
+        }
+    }
+
+    #[test]
+    fn a_start_on_the_middle_axis_within_round_off_stays_there() {
+        // Found by the property tests: the middle (unstable) axis is yaw here, and the other
+        // components are ~1e-149 of |m|, so k² rounds to 1 and sn ν to 1: the direct phase
+        // F(π/2 | 1) is infinite. The exact solution leaves the axis like e^{λt} · 1e-149.
+        let body = FreeRigidBody::new(Vector3::new(1.4365355e8, 1.022303625e10, 3.9875e9)).unwrap();
+        let m0 = Vector3::new(7.493675271476608e-142, -9.589185400761611e-141, 290756659.433808);
+        for order in [MagnusOrder::Two, MagnusOrder::Four, MagnusOrder::Six] {
+            for t in [0.5, 3.0, 30.0, -3.0] {
+                let (m1, q1) = body.flow(&m0, &Matrix3::identity(), t, order);
+                assert!(m1.iter().all(|v| v.is_finite()), "{order:?} t={t}: {m1:?}");
+                assert!((m1 - m0).norm() <= 1e-12 * m0.norm(), "{order:?} t={t}: {m1:?}");
+                assert!(so3::orthogonality_defect(&q1) < 1e-14);
+                // a rotation about yaw at rate m_z / T_z
+                let angle = so3::log(&q1).z;
+                let expect = (m0.z / 3.9875e9 * t + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+                assert!((angle - expect).abs() < 1e-12, "{angle} vs {expect}");
+            }
         }
     }
 }

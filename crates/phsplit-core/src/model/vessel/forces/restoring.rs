@@ -1,0 +1,73 @@
+//! Hydrostatic restoring forces in the paper's energy-consistent form (paper §3.4, eqs. 35–39;
+//! docs/model.md §2, §5).
+//!
+//! Heave: the force `−Qᵀ Λ x`, `Λ = diag(0, 0, c)`, `c = g ρ A_wp`. Roll and pitch: the moment
+//! `−mu × q3` with the restoring variable `mu` (= `G Qᵀe3` on exact solutions),
+//! `mu' = −G (w × q3)`, `G = mv g diag(GM_L, GM_T, 0)`. Both are conservative exchanges between
+//! the kinetic energy and the stored energy `½ muᵀG⁺mu + ½ c x_z²`, which this component adds
+//! to H: nothing is booked in the ledger. Flow S2.
+
+use super::{Force, Frozen, Rows, S2Builder, Sys};
+use crate::lie::so3;
+use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::state::VesselState;
+use nalgebra::{Matrix3, Vector3};
+use std::sync::Arc;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Restoring {
+    /// Diagonal of `G`, N m.
+    pub g: Vector3<f64>,
+    /// Diagonal of `G⁺`.
+    pub g_plus: Vector3<f64>,
+    /// Heave stiffness `c = g ρ A_wp`, N/m.
+    pub heave: f64,
+}
+
+/// Keys `vessel.gm_transverse`, `gm_longitudinal` (m), `gravity` (m/s²), `water_density`
+/// (kg/m³), `waterplane_area` (m²): all required, > 0.
+pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+    let gm_t = p.f64("vessel", "gm_transverse", "m", Range::Positive)?;
+    let gm_l = p.f64("vessel", "gm_longitudinal", "m", Range::Positive)?;
+    let gravity = p.f64("vessel", "gravity", "m/s^2", Range::Positive)?;
+    let rho = p.f64("vessel", "water_density", "kg/m^3", Range::Positive)?;
+    let awp = p.f64("vessel", "waterplane_area", "m^2", Range::Positive)?;
+    let w = body.mass * gravity;
+    let g = Vector3::new(w * gm_l, w * gm_t, 0.0);
+    Ok(Some(Arc::new(Restoring {
+        g,
+        g_plus: g.map(|v| if v == 0.0 { 0.0 } else { 1.0 / v }),
+        heave: gravity * rho * awp,
+    })))
+}
+
+impl Force for Restoring {
+    fn name(&self) -> &'static str {
+        "restoring"
+    }
+    fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
+        // Heave, in v = x − x_o: −c (v_z + x_o,z) Qᵀe3.
+        let col = fr.qt.column(2).into_owned();
+        let mut fv = Matrix3::zeros();
+        fv.set_column(2, &(col * -self.heave));
+        let c = col * (-self.heave * fr.origin.z);
+        b.force(Sys::Trans, None, &Rows { fv, c, ..Rows::ZERO });
+        // Roll and pitch: −mu × q3 = hat(q3) mu; mu' = G hat(q3) T⁻¹ m.
+        let hq3 = so3::hat(&fr.q3);
+        b.force(Sys::Rot, None, &Rows { fv: hq3, ..Rows::ZERO });
+        let tinv = fr.body.inertia_inv;
+        let mut avu = hq3;
+        for i in 0..3 {
+            for j in 0..3 {
+                avu[(i, j)] *= self.g[i] * tinv[j];
+            }
+        }
+        b.rows(Sys::Rot).avu += avu;
+    }
+    fn storage(&self, s: &VesselState) -> f64 {
+        0.5 * s.mu.component_mul(&s.mu).dot(&self.g_plus) + 0.5 * self.heave * s.x.z * s.x.z
+    }
+    fn init_state(&self, s: &mut VesselState) {
+        s.mu = self.g.component_mul(&(s.q.transpose() * Vector3::z()));
+    }
+}

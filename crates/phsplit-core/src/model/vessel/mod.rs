@@ -1,0 +1,191 @@
+//! The vessel under dynamic-positioning control (paper §3.4, eqs. 29–41; docs/model.md §2).
+//!
+//! Body-frame velocities `v` (linear) and `w` (angular), attitude `Q` (body → spatial), spatial
+//! position `x` (z up). The vessel is a rigid body ([`Body`]: mass and principal inertias)
+//! with forces and ports as components ([`forces`]), a default initial state ([`Initial`]),
+//! and the dynamical system built from them for a run ([`system::VesselSystem`]).
+//!
+//! Energy (eq. 35): `H = ½ mᵀT⁻¹m + ½|p|²/mv + Σ` the components' stores (the restoring
+//! forces': `½ muᵀG⁺mu + ½ c x_z²`). The forces' power is booked per component in the ledger,
+//! so that `dH/dt = Σ port power − Σ dissipation`.
+
+pub mod forces;
+pub mod params;
+pub mod state;
+pub mod system;
+
+use crate::error::Result;
+use crate::flows::rigid_body::FreeRigidBody;
+use crate::lie::so3;
+use forces::Force;
+use nalgebra::Vector3;
+use params::{Params, Range};
+pub use state::{VesselState, LAYOUT, STATE_DIM};
+use std::sync::Arc;
+pub use system::{LinearFlow, VesselSystem};
+
+/// The paper's vessel (Appendix D, as restated in docs/model.md §4), as TOML.
+pub const PAPER_VESSEL_TOML: &str = include_str!("../../../data/paper_vessel.toml");
+
+/// The rigid body: mass and principal inertias (keys `vessel.mass`, `vessel.inertia`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Body {
+    /// `mv`, kg.
+    pub mass: f64,
+    /// `T = diag(T1, T2, T3)` roll, pitch, yaw, kg m².
+    pub inertia: Vector3<f64>,
+    /// `T⁻¹`.
+    pub inertia_inv: Vector3<f64>,
+    /// The free rigid body of flow S1.
+    pub free: FreeRigidBody,
+}
+
+impl Body {
+    fn read(p: &mut Params) -> Result<Self> {
+        let mass = p.f64("vessel", "mass", "kg", Range::Positive)?;
+        let inertia: Vector3<f64> = p
+            .vec3("vessel", "inertia", None, "kg m^2", Range::Positive)?
+            .into();
+        Ok(Self {
+            mass,
+            inertia,
+            inertia_inv: inertia.map(|v| 1.0 / v),
+            free: FreeRigidBody::new(inertia)?,
+        })
+    }
+    /// Kinetic energy `½ mᵀT⁻¹m + ½|p|²/mv`, J.
+    pub fn kinetic_energy(&self, s: &VesselState) -> f64 {
+        self.free.kinetic_energy(&s.m) + 0.5 * s.p.norm_squared() / self.mass
+    }
+}
+
+/// The default initial state, in engineering variables (table `[initial]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Initial {
+    /// ZYX Euler angles (roll, pitch, yaw), rad.
+    pub euler: [f64; 3],
+    /// Spatial position, m.
+    pub position: [f64; 3],
+    /// Body linear velocity, m/s (default 0).
+    pub velocity: [f64; 3],
+    /// Body angular velocity, rad/s (default 0).
+    pub angular_velocity: [f64; 3],
+}
+
+impl Initial {
+    fn read(p: &mut Params) -> Result<Self> {
+        const T: &str = "initial";
+        Ok(Self {
+            euler: p.vec3(T, "euler", None, "rad", Range::Finite)?,
+            position: p.vec3(T, "position", None, "m", Range::Finite)?,
+            velocity: p.vec3(T, "velocity", Some([0.0; 3]), "m/s", Range::Finite)?,
+            angular_velocity: p.vec3(T, "angular_velocity", Some([0.0; 3]), "rad/s", Range::Finite)?,
+        })
+    }
+}
+
+/// A vessel: rigid body, forces and ports, and default initial state, validated.
+#[derive(Debug, Clone)]
+pub struct Vessel {
+    pub body: Body,
+    pub initial: Initial,
+    /// The components, in the order of [`forces::COMPONENTS`].
+    pub forces: Vec<Arc<dyn Force>>,
+    /// Every parameter as read (defaults filled in): the normalised vessel file.
+    pub params: toml::Table,
+}
+
+impl Vessel {
+    /// Build a vessel from a parameter file's text: `[vessel]`, `[control]`, `[initial]` and
+    /// the tables of optional components. Every key is read by one part of the model and
+    /// validated there; a key nobody reads is refused.
+    pub fn from_toml_str(text: &str) -> Result<Self> {
+        Self::from_params(Params::parse(text)?)
+    }
+
+    /// Build a vessel from a parsed parameter table.
+    pub fn from_table(table: toml::Table) -> Result<Self> {
+        Self::from_params(Params::from_table(table))
+    }
+
+    fn from_params(mut p: Params) -> Result<Self> {
+        let body = Body::read(&mut p)?;
+        let mut forces = Vec::new();
+        for (_, _, build) in forces::COMPONENTS {
+            if let Some(f) = build(&mut p, &body)? {
+                forces.push(f);
+            }
+        }
+        let initial = Initial::read(&mut p)?;
+        let params = p.finish()?;
+        Ok(Self {
+            body,
+            initial,
+            forces,
+            params,
+        })
+    }
+
+    /// The tables a vessel file may have: the body's and initial state's, and the components'.
+    pub fn tables() -> Vec<&'static str> {
+        let mut t = vec!["vessel", "initial"];
+        for (_, table, _) in forces::COMPONENTS {
+            if !t.contains(table) {
+                t.push(table);
+            }
+        }
+        t
+    }
+
+    /// The paper's vessel and scenario (docs/model.md §4).
+    pub fn paper() -> Self {
+        Self::from_toml_str(PAPER_VESSEL_TOML).expect("the shipped parameter file is valid")
+    }
+
+    /// The component registered as `name`, if the vessel has it.
+    pub fn force(&self, name: &str) -> Option<&Arc<dyn Force>> {
+        self.forces.iter().find(|f| f.name() == name)
+    }
+
+    /// The state from engineering variables: attitude from ZYX Euler angles, `p = mv v`,
+    /// `m = T w`, the components' own states consistent with them (`mu = G Qᵀe3`), integral
+    /// states zero.
+    pub fn state_from(
+        &self,
+        euler: Vector3<f64>,
+        position: Vector3<f64>,
+        velocity: Vector3<f64>,
+        angular_velocity: Vector3<f64>,
+    ) -> VesselState {
+        let z = Vector3::zeros();
+        let mut s = VesselState {
+            p: velocity * self.body.mass,
+            m: angular_velocity.component_mul(&self.body.inertia),
+            q: so3::from_euler_zyx(&euler),
+            mu: z,
+            x: position,
+            phi_th: z,
+            phi_x: z,
+        };
+        for f in &self.forces {
+            f.init_state(&mut s);
+        }
+        s
+    }
+
+    /// The default initial state of the file.
+    pub fn initial_state(&self) -> VesselState {
+        let i = &self.initial;
+        self.state_from(
+            i.euler.into(),
+            i.position.into(),
+            i.velocity.into(),
+            i.angular_velocity.into(),
+        )
+    }
+
+    /// The energy `H` of eq. (35), J (without constant terms).
+    pub fn energy(&self, s: &VesselState) -> f64 {
+        self.body.kinetic_energy(s) + self.forces.iter().map(|f| f.storage(s)).sum::<f64>()
+    }
+}

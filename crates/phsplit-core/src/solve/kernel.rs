@@ -1,0 +1,343 @@
+//! The integration kernels: one for every composition method, one for every Butcher tableau.
+//!
+//! A kernel never knows it is a ship: it sees a model only through the traits of
+//! [`super::system`].
+//!
+//! **Time dependence.** The only explicit time dependence the models have is a switch (the
+//! controller turned on at a time). Kernels pass each flow and each stage the *start time of its
+//! step*, so a switch acts at the first step boundary at or after its time and every step
+//! integrates one autonomous field.
+
+use super::options::Options;
+use super::system::{FieldModel, Flow, SplitModel, Work};
+use super::trajectory::{saves_after, Recorder, Trajectory};
+use crate::error::Result;
+use crate::methods::{ButcherTableau, Composition, Method};
+use nalgebra::SVector;
+
+/// Run a composition method (paper format (10); Lie–Trotter) on a split model.
+///
+/// Adjacent sub-steps of the same flow are merged within a step (done once, in the method
+/// table) and across step boundaries that are not saved and where the field does not switch
+/// (first same as last).
+pub fn run_splitting<M: SplitModel>(
+    model: &M,
+    method: &Composition,
+    y0: M::State,
+    opts: &Options,
+) -> Result<Trajectory<M::State>> {
+    opts.validate()?;
+    model.supports_order(method.order)?;
+    let (fa, fb) = opts.outer.flows();
+    let subs: Vec<(Flow, f64)> = method
+        .substeps
+        .iter()
+        .map(|&(is_a, c)| (if is_a { fa } else { fb }, c))
+        .collect();
+    let fsal = subs.len() > 1 && subs[0].0 == subs[subs.len() - 1].0;
+    let last = subs.len() - 1;
+    let mut rec = Recorder::new(model, opts.t0, y0, opts);
+    let mut y = y0;
+    // A last sub-step deferred into the next step: (flow, length, its step's start time).
+    let mut pending: Option<(Flow, f64, f64)> = None;
+    for n in 0..opts.n_steps {
+        let t = opts.t0 + n as f64 * opts.h;
+        for (i, &(flow, c)) in subs.iter().enumerate() {
+            let mut len = c * opts.h;
+            if i == 0 {
+                if let Some((pf, plen, pt)) = pending.take() {
+                    if pf == flow && model.same_field(pt, t) {
+                        len += plen;
+                    } else {
+                        rec.acc += model.flow(pf, plen, pt, method.order, opts.ledger, &mut y);
+                    }
+                }
+            }
+            if i == last && fsal && !saves_after(n, opts) && model.same_field(t, t + opts.h) {
+                pending = Some((flow, len, t));
+                continue;
+            }
+            rec.acc += model.flow(flow, len, t, method.order, opts.ledger, &mut y);
+        }
+        if !model.is_finite(&y) {
+            return Ok(rec.fail(n, t));
+        }
+        rec.traj.steps = n + 1;
+        if pending.is_none() {
+            // y sits on the step boundary (no sub-step deferred into the next step).
+            rec.traj.last_good = y;
+            rec.traj.t_last_good = t + opts.h;
+        }
+        if saves_after(n, opts) {
+            rec.save(t + opts.h, y);
+        }
+    }
+    Ok(rec.traj)
+}
+
+/// Run an explicit Runge–Kutta method on the full vector field.
+pub fn run_runge_kutta<const N: usize, M: FieldModel<N>>(
+    model: &M,
+    tableau: &ButcherTableau,
+    y0: M::State,
+    opts: &Options,
+) -> Result<Trajectory<M::State>> {
+    opts.validate()?;
+    let s = tableau.stages();
+    let mut rec = Recorder::new(model, opts.t0, y0, opts);
+    let mut y = model.to_vector(&y0);
+    let mut k: Vec<SVector<f64, N>> = vec![SVector::zeros(); s];
+    let h = opts.h;
+    for n in 0..opts.n_steps {
+        let t = opts.t0 + n as f64 * h;
+        let mut work = Work::default();
+        for i in 0..s {
+            let mut yi = y;
+            for (j, aij) in tableau.a[i].iter().enumerate() {
+                if *aij != 0.0 {
+                    yi.axpy(h * aij, &k[j], 1.0);
+                }
+            }
+            k[i] = model.rhs(t, &yi);
+            if opts.ledger {
+                work += model.power(t, &yi).scaled(h * tableau.b[i]);
+            }
+        }
+        let mut y1 = y;
+        for i in 0..s {
+            y1.axpy(h * tableau.b[i], &k[i], 1.0);
+        }
+        // Finiteness is checked on the vector; the state is built only when it is saved, and
+        // the last good state at the end (or at a failure: `y` is then the last good one).
+        if !y1.as_slice().iter().all(|v| v.is_finite()) {
+            rec.traj.last_good = model.from_vector(&y);
+            rec.traj.t_last_good = t;
+            return Ok(rec.fail(n, t));
+        }
+        y = y1;
+        rec.acc += work;
+        rec.traj.steps = n + 1;
+        if saves_after(n, opts) {
+            rec.save(t + h, model.from_vector(&y));
+        }
+    }
+    rec.traj.last_good = model.from_vector(&y);
+    rec.traj.t_last_good = opts.t0 + opts.n_steps as f64 * h;
+    Ok(rec.traj)
+}
+
+/// Run any method on a model that offers both views.
+pub fn run<const N: usize, M: SplitModel + FieldModel<N>>(
+    model: &M,
+    method: &Method,
+    y0: M::State,
+    opts: &Options,
+) -> Result<Trajectory<M::State>> {
+    match method {
+        Method::Splitting(c) => run_splitting(model, c, y0, opts),
+        Method::RungeKutta(t) => run_runge_kutta(model, t, y0, opts),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The kernels on a model with closed forms, written for the test: a damped oscillator
+    //! with a constant input, `q' = p`, `p' = −q − d p + u`, `H = ½(q² + p²)`, split into the
+    //! rotation `q' = p, p' = −q` (S1, conservative) and `p' = −d p + u` (S2, dissipative with
+    //! the port `u`: supplied `∫ p u dt`, dissipated `∫ d p² dt`).
+    use super::*;
+    use crate::methods::{Method, Outer, REGISTRY};
+    use crate::solve::system::{Account, AccountKind, Model};
+    use crate::solve::Status;
+
+    const D: f64 = 0.3;
+    const U: f64 = 0.7;
+
+    struct Osc {
+        /// Blow up the S2 flow (for the failure path): `p' = +growth p`.
+        growth: Option<f64>,
+    }
+    const ACC: [Account; 2] = [
+        Account { name: "input", kind: AccountKind::Supplied },
+        Account { name: "damping", kind: AccountKind::Dissipated },
+    ];
+
+    impl Model for Osc {
+        type State = [f64; 2];
+        fn energy(&self, s: &[f64; 2]) -> f64 {
+            0.5 * (s[0] * s[0] + s[1] * s[1])
+        }
+        fn is_finite(&self, s: &[f64; 2]) -> bool {
+            s.iter().all(|v| v.is_finite())
+        }
+        fn same_field(&self, _: f64, _: f64) -> bool {
+            true
+        }
+        fn accounts(&self) -> &[Account] {
+            &ACC
+        }
+    }
+
+    impl SplitModel for Osc {
+        fn supports_order(&self, order: usize) -> Result<()> {
+            assert!(order <= 6);
+            Ok(())
+        }
+        fn flow(&self, which: Flow, h: f64, _t: f64, _o: usize, ledger: bool, s: &mut [f64; 2]) -> Work {
+            let mut w = Work::default();
+            match which {
+                Flow::S1 => {
+                    let (c, sn) = (h.cos(), h.sin());
+                    *s = [c * s[0] + sn * s[1], -sn * s[0] + c * s[1]];
+                }
+                Flow::S2 => {
+                    if let Some(g) = self.growth {
+                        s[1] *= (g * h).exp();
+                        return w;
+                    }
+                    // p(t) = u/d + (p0 − u/d) e^{−dt}; the ledger's integrals in closed form.
+                    let (pe, a) = (U / D, s[1] - U / D);
+                    let e = (-D * h).exp();
+                    if ledger {
+                        let int_p = pe * h + a * (1.0 - e) / D;
+                        let int_p2 = pe * pe * h + 2.0 * pe * a * (1.0 - e) / D
+                            + a * a * (1.0 - e * e) / (2.0 * D);
+                        w.0[0] = U * int_p;
+                        w.0[1] = D * int_p2;
+                    }
+                    s[1] = pe + a * e;
+                }
+            }
+            w
+        }
+    }
+
+    impl FieldModel<2> for Osc {
+        fn to_vector(&self, s: &[f64; 2]) -> SVector<f64, 2> {
+            SVector::<f64, 2>::new(s[0], s[1])
+        }
+        fn from_vector(&self, y: &SVector<f64, 2>) -> [f64; 2] {
+            [y[0], y[1]]
+        }
+        fn rhs(&self, _t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
+            let g = self.growth.map_or(-D, |g| g);
+            SVector::<f64, 2>::new(y[1], -y[0] + g * y[1] + if self.growth.is_some() { 0.0 } else { U })
+        }
+        fn power(&self, _t: f64, y: &SVector<f64, 2>) -> Work {
+            let mut w = Work::default();
+            w.0[0] = y[1] * U;
+            w.0[1] = D * y[1] * y[1];
+            w
+        }
+    }
+
+    /// The exact solution: `e = q − u` solves `e'' + d e' + e = 0` (under-damped).
+    fn exact(t: f64, y0: [f64; 2]) -> [f64; 2] {
+        let om = (1.0 - D * D / 4.0).sqrt();
+        let (e0, v0) = (y0[0] - U, y0[1]);
+        let b = (v0 + 0.5 * D * e0) / om;
+        let k = (-0.5 * D * t).exp();
+        let (c, s) = ((om * t).cos(), (om * t).sin());
+        let e = k * (e0 * c + b * s);
+        let v = k * (-0.5 * D * (e0 * c + b * s) + (-e0 * om * s + b * om * c));
+        [U + e, v]
+    }
+
+    fn opts(h: f64, n: usize, save_every: usize, outer: Outer) -> Options {
+        Options { t0: 0.0, h, n_steps: n, save_every, outer, ledger: true }
+    }
+
+    #[test]
+    fn every_registered_method_converges_at_its_order() {
+        let y0 = [1.0, -0.5];
+        let t_end = 2.0;
+        let ex = exact(t_end, y0);
+        for entry in REGISTRY {
+            let m: Method = entry.name.parse().unwrap();
+            for outer in [Outer::Dissipative, Outer::Conservative] {
+                let hs: Vec<f64> = (2..7).map(|k| t_end / (1 << k) as f64).collect();
+                let errs: Vec<f64> = hs
+                    .iter()
+                    .map(|&h| {
+                        let n = (t_end / h).round() as usize;
+                        let tr = run(&Osc { growth: None }, &m, y0, &opts(h, n, n, outer)).unwrap();
+                        let y = tr.states.last().unwrap();
+                        ((y[0] - ex[0]).powi(2) + (y[1] - ex[1]).powi(2)).sqrt()
+                    })
+                    .collect();
+                // Least-squares slope of log(err) against log(h), over the points above round-off.
+                let pts: Vec<(f64, f64)> = hs
+                    .iter()
+                    .zip(&errs)
+                    .filter(|(_, e)| **e > 1e-13)
+                    .map(|(h, e)| (h.ln(), e.ln()))
+                    .collect();
+                assert!(pts.len() >= 3, "{}: too few points above round-off: {errs:?}", entry.name);
+                let n = pts.len() as f64;
+                let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+                let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+                    / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+                assert!(
+                    (slope - m.order() as f64).abs() < 0.3,
+                    "{} ({outer:?}): fitted order {slope:.3}, expected {}; errors {errs:?}",
+                    entry.name,
+                    m.order()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn merged_sub_steps_equal_the_unmerged_composition() {
+        // Saving every step forbids merging across boundaries; saving at the end allows it.
+        for name in ["lie", "sp2", "sp4", "sp6"] {
+            let m: Method = name.parse().unwrap();
+            for outer in [Outer::Dissipative, Outer::Conservative] {
+                let a = run(&Osc { growth: None }, &m, [1.0, 0.2], &opts(0.1, 50, 1, outer)).unwrap();
+                let b = run(&Osc { growth: None }, &m, [1.0, 0.2], &opts(0.1, 50, 50, outer)).unwrap();
+                let (ya, yb) = (a.states.last().unwrap(), b.states.last().unwrap());
+                assert!((ya[0] - yb[0]).abs() < 1e-13 && (ya[1] - yb[1]).abs() < 1e-13, "{name}");
+                // The ledger adds up the same.
+                let sa: f64 = a.supplied.iter().sum();
+                assert!((sa - b.supplied[1]).abs() < 1e-13, "{name}: {sa} vs {}", b.supplied[1]);
+            }
+        }
+    }
+
+    #[test]
+    fn saving_and_the_ledger() {
+        let m: Method = "sp2".parse().unwrap();
+        let tr = run(&Osc { growth: None }, &m, [1.0, 0.0], &opts(0.1, 10, 3, Outer::Dissipative)).unwrap();
+        // Steps 3, 6, 9 and the last (10) are saved, after the initial state.
+        let t: Vec<f64> = tr.t.iter().map(|t| (t * 10.0).round()).collect();
+        assert_eq!(t, [0.0, 3.0, 6.0, 9.0, 10.0]);
+        assert_eq!(tr.steps, 10);
+        assert_eq!(tr.status, Status::Completed);
+        assert_eq!(tr.account("damping").unwrap().len(), 5);
+        // Positive steps (Prop. 2.2): ΔH = supplied − dissipated to round-off, by account.
+        for i in 1..tr.t.len() {
+            let dh = tr.energy[i] - tr.energy[i - 1];
+            assert!((dh - (tr.booked[i].0[0] - tr.booked[i].0[1])).abs() < 1e-14);
+            assert!(tr.dissipated[i] > 0.0);
+        }
+        assert_eq!(tr.last_good, *tr.states.last().unwrap());
+    }
+
+    #[test]
+    fn a_run_that_blows_up_fails_with_what_it_had() {
+        let osc = Osc { growth: Some(30.0) };
+        for name in ["sp2", "rk4"] {
+            let m: Method = name.parse().unwrap();
+            let tr = run(&osc, &m, [1.0, 1.0], &opts(1.0, 400, 1, Outer::Dissipative)).unwrap();
+            let Status::Failed { step, .. } = tr.status else { panic!("{name} did not fail") };
+            assert!(step > 0 && step < 400, "{name}: {step}");
+            assert_eq!(tr.steps, step);
+            assert!(tr.states.iter().all(|s| s.iter().all(|v| v.is_finite())));
+            assert!(tr.last_good.iter().all(|v| v.is_finite()));
+            assert_eq!(tr.t.len(), step + 1);
+        }
+        // Bad options are refused before the first step.
+        let e = run(&Osc { growth: None }, &"sp2".parse().unwrap(), [0.0; 2], &opts(0.0, 1, 1, Outer::Dissipative));
+        assert!(e.unwrap_err().to_string().contains("h must be"));
+    }
+}

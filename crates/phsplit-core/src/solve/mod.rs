@@ -1,0 +1,11 @@
+//! The solver: kernels, options, trajectories and saving. It never imports a model; models
+//! implement the traits of [`system`].
+pub mod kernel;
+pub mod options;
+pub mod system;
+pub mod trajectory;
+
+pub use kernel::{run, run_runge_kutta, run_splitting};
+pub use options::{Options, MAX_STEPS};
+pub use system::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
+pub use trajectory::{Status, Trajectory};

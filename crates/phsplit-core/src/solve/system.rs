@@ -1,0 +1,102 @@
+//! What the solver needs of a model: the traits a model implements, and the ledger's units.
+//!
+//! The solver defines these and never imports a model; a model (the vessel, or a test's toy
+//! system) implements them. A kernel sees a model only through [`SplitModel`] (two flows) or
+//! [`FieldModel`] (one vector field), plus the energy and the ledger accounts of [`Model`].
+
+use nalgebra::SVector;
+
+/// Most ledger accounts a model may declare.
+pub const MAX_ACCOUNTS: usize = 8;
+
+/// Whether an account books energy that flowed in through a port or energy dissipated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AccountKind {
+    /// Work done on the system through a port, `∫ ν·τ dt` (either sign).
+    Supplied,
+    /// Energy dissipated, `∫ νᵀDν dt` (≥ 0 for a dissipative component).
+    Dissipated,
+}
+
+/// One account of the energy ledger: the work of one port, or the dissipation of one component.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Account {
+    /// Name, unique within the model (`"control"`, `"damping"`, `"external"`, …).
+    pub name: &'static str,
+    pub kind: AccountKind,
+}
+
+/// Energy (J) or power (W) booked per account, in the order of [`Model::accounts`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Work(pub [f64; MAX_ACCOUNTS]);
+
+impl std::ops::AddAssign for Work {
+    fn add_assign(&mut self, o: Self) {
+        for (a, b) in self.0.iter_mut().zip(o.0) {
+            *a += b;
+        }
+    }
+}
+
+impl Work {
+    /// `h · self`: a power held over `h`.
+    pub fn scaled(mut self, h: f64) -> Self {
+        self.0.iter_mut().for_each(|v| *v *= h);
+        self
+    }
+    /// The total of the accounts of `kind`.
+    pub fn total(&self, accounts: &[Account], kind: AccountKind) -> f64 {
+        accounts
+            .iter()
+            .zip(self.0)
+            .filter(|(a, _)| a.kind == kind)
+            .map(|(_, v)| v)
+            .sum()
+    }
+}
+
+/// What every kernel needs of a model.
+pub trait Model {
+    type State: Copy;
+    /// Stored energy (the Hamiltonian).
+    fn energy(&self, s: &Self::State) -> f64;
+    /// Whether the state is usable (finite).
+    fn is_finite(&self, s: &Self::State) -> bool;
+    /// Whether the model's field is the same on steps starting at `t_a` and `t_b` (no switch
+    /// between them): sub-steps of the same flow may then be merged across the boundary.
+    fn same_field(&self, t_a: f64, t_b: f64) -> bool;
+    /// The ledger's accounts (at most [`MAX_ACCOUNTS`]); [`Work`] values follow this order.
+    fn accounts(&self) -> &[Account];
+}
+
+/// Which of the two flows of a split model a sub-step belongs to.
+pub use crate::methods::Flow;
+
+/// A model split into a conservative flow S1 and a dissipative flow S2, each with a flow map.
+pub trait SplitModel: Model {
+    /// Check that the model can provide sub-flows of order `order` (paper Remark 2.3); the
+    /// kernel asks this once, before the first step.
+    fn supports_order(&self, order: usize) -> crate::Result<()>;
+    /// Advance `s` by flow `which` over `h` (of either sign) on a step that starts at `t_step`.
+    /// `order` is the order of the composition, for flows that are approximated to match.
+    /// Returns the energy booked per account over the sub-step when `ledger` is set.
+    fn flow(
+        &self,
+        which: Flow,
+        h: f64,
+        t_step: f64,
+        order: usize,
+        ledger: bool,
+        s: &mut Self::State,
+    ) -> Work;
+}
+
+/// A model given by one vector field on `R^N`.
+pub trait FieldModel<const N: usize>: Model {
+    fn to_vector(&self, s: &Self::State) -> SVector<f64, N>;
+    fn from_vector(&self, y: &SVector<f64, N>) -> Self::State;
+    /// `y'` on a step that starts at `t_step`.
+    fn rhs(&self, t_step: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
+    /// The power per account at `y` on a step that starts at `t_step`.
+    fn power(&self, t_step: f64, y: &SVector<f64, N>) -> Work;
+}

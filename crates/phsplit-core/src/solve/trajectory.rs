@@ -1,0 +1,124 @@
+//! What a run returns: saved states, the energy ledger per saved interval, and how it ended.
+
+use super::options::Options;
+use super::system::{Account, AccountKind, Model, Work};
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Status {
+    Completed,
+    /// The state became non-finite during step `step` (starting at `t`); the trajectory holds
+    /// everything saved before, and the last good state.
+    Failed {
+        step: usize,
+        t: f64,
+        reason: String,
+    },
+}
+
+/// Saved states and the ledger of a run.
+///
+/// **Ledger.** For every saved interval: the change of stored energy `ΔH` (from `energy`), and
+/// the energy booked by each account of the model (`booked`, in the order of `accounts`):
+/// supplied through a port, or dissipated. `supplied` and `dissipated` are their totals.
+/// Splitting methods book exactly along their sub-flows (the conservative flow books nothing),
+/// so `ΔH = supplied − dissipated` holds to round-off for positive-step methods (paper
+/// Prop. 2.2). Runge–Kutta methods book the method's own quadrature of the power,
+/// `h Σ bᵢ P(Yᵢ)`, and the residual shows the energy they create or destroy.
+#[derive(Debug, Clone)]
+pub struct Trajectory<S> {
+    /// Saved times.
+    pub t: Vec<f64>,
+    /// Saved states.
+    pub states: Vec<S>,
+    /// `H` at the saved states.
+    pub energy: Vec<f64>,
+    /// The model's ledger accounts.
+    pub accounts: Vec<Account>,
+    /// Energy booked per account since the previous saved state (zero for the first).
+    pub booked: Vec<Work>,
+    /// Energy supplied through the ports since the previous saved state (0 for the first).
+    pub supplied: Vec<f64>,
+    /// Energy dissipated since the previous saved state (0 for the first).
+    pub dissipated: Vec<f64>,
+    /// Steps taken.
+    pub steps: usize,
+    pub status: Status,
+    /// The last finite state reached (the final state of a completed run).
+    pub last_good: S,
+    /// Time of `last_good`.
+    pub t_last_good: f64,
+}
+
+impl<S> Trajectory<S> {
+    /// The series of one account (J per saved interval), by name.
+    pub fn account(&self, name: &str) -> Option<Vec<f64>> {
+        let k = self.accounts.iter().position(|a| a.name == name)?;
+        Some(self.booked.iter().map(|w| w.0[k]).collect())
+    }
+}
+
+/// Builds a trajectory as a kernel runs: saving, accumulating the ledger, failing.
+pub(crate) struct Recorder<'m, M: Model> {
+    model: &'m M,
+    pub(crate) traj: Trajectory<M::State>,
+    pub(crate) acc: Work,
+}
+
+impl<'m, M: Model> Recorder<'m, M> {
+    pub(crate) fn new(model: &'m M, t0: f64, y0: M::State, opts: &Options) -> Self {
+        let capacity = (opts.n_steps / opts.save_every + 2).min(1 << 24);
+        let mut traj = Trajectory {
+            t: Vec::with_capacity(capacity),
+            states: Vec::with_capacity(capacity),
+            energy: Vec::with_capacity(capacity),
+            accounts: model.accounts().to_vec(),
+            booked: Vec::with_capacity(capacity),
+            supplied: Vec::with_capacity(capacity),
+            dissipated: Vec::with_capacity(capacity),
+            steps: 0,
+            status: Status::Completed,
+            last_good: y0,
+            t_last_good: t0,
+        };
+        traj.t.push(t0);
+        traj.states.push(y0);
+        traj.energy.push(model.energy(&y0));
+        traj.booked.push(Work::default());
+        traj.supplied.push(0.0);
+        traj.dissipated.push(0.0);
+        Self {
+            model,
+            traj,
+            acc: Work::default(),
+        }
+    }
+    /// End the run: the state became non-finite during step `step`, which started at `t`.
+    pub(crate) fn fail(mut self, step: usize, t: f64) -> Trajectory<M::State> {
+        self.traj.status = Status::Failed {
+            step,
+            t,
+            reason: "the state became non-finite".into(),
+        };
+        self.traj
+    }
+    pub(crate) fn save(&mut self, t: f64, y: M::State) {
+        let acc = &self.traj.accounts;
+        self.traj.t.push(t);
+        self.traj.states.push(y);
+        self.traj.energy.push(self.model.energy(&y));
+        self.traj
+            .supplied
+            .push(self.acc.total(acc, AccountKind::Supplied));
+        self.traj
+            .dissipated
+            .push(self.acc.total(acc, AccountKind::Dissipated));
+        self.traj.booked.push(self.acc);
+        self.acc = Work::default();
+    }
+}
+
+/// Whether the state after step `step` (0-based) is saved.
+pub(crate) fn saves_after(step: usize, opts: &Options) -> bool {
+    (step + 1) % opts.save_every == 0 || step + 1 == opts.n_steps
+}
