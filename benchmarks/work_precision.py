@@ -40,7 +40,8 @@ import numpy as np  # noqa: E402
 
 import phsplit  # noqa: E402
 from phsplit import _core  # noqa: E402
-from phsplit import reference as ref  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python", "tests"))
+import reference as ref  # noqa: E402  (the independent numpy model of eq. 39, a test oracle)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 VESSEL = phsplit.Vessel.paper()

@@ -56,6 +56,12 @@ def initial_with(index: slice | int, value) -> Callable[[], object]:
     return run
 
 
+def _reflected():
+    y = phsplit.Vessel.paper().initial_state()
+    y[12:15] *= -1.0  # third column of Q negated: det Q = -1
+    return y
+
+
 E = phsplit.InvalidInputError
 P = phsplit.ScenarioParseError
 
@@ -90,6 +96,19 @@ CATALOGUE: list[Bad] = [
     Bad("missing key", vessel_with("gravity = 9.81", ""), P, ("gravity", "missing")),
     Bad("text where a number belongs", vessel_with("mass = 6.3622085e6", 'mass = "heavy"'), P, ("mass",)),
     Bad("TOML syntax error", vessel_with("[control]", "[control"), P, ("line", "column")),
+    # the external load (a component's own table)
+    Bad("external force with two entries", vessel_with("[initial]", "[external]\nforce = [1.0, 2.0]\n[initial]"), P,
+        ("external.force", "3 numbers")),
+    Bad("NaN external moment", vessel_with("[initial]", "[external]\nmoment = [0.0, nan, 0.0]\n[initial]"), E,
+        ("external.moment[1]", "finite")),
+    Bad("unknown external frame", vessel_with("[initial]", '[external]\nframe = "ned"\n[initial]'), E,
+        ("external.frame", "'body', 'spatial'")),
+    Bad("external load kilometres off the hull", vessel_with("[initial]", "[external]\npoint = [0.0, 0.0, 5e3]\n[initial]"),
+        E, ("external.point[2]", "within 1000 m")),
+    Bad("misspelt external key", vessel_with("[initial]", "[external]\nforse = [1.0, 0.0, 0.0]\n[initial]"), P,
+        ("forse", "did you mean 'force'")),
+    Bad("misspelt component table", vessel_with("[initial]", "[externl]\nforce = [1.0, 0.0, 0.0]\n[initial]"), P,
+        ("externl", "did you mean 'external'")),
     # simulation arguments
     Bad("zero step", sim(h=0.0), E, ("h", "> 0")),
     Bad("negative step", sim(h=-0.5), E, ("h", "> 0")),
@@ -106,12 +125,17 @@ CATALOGUE: list[Bad] = [
     Bad("save_every not an integer", sim(save_every=1.5), E, ("save_every", "integer")),
     Bad("unknown linear flow", sim(linear_flow="pade"), E, ("linear_flow", "exact", "gauss")),
     Bad("NaN controller start", sim(control_start=math.nan), E, ("control_start", "finite")),
+    Bad("step given as a boolean", sim(h=True), E, ("h", "number")),
+    Bad("controller start given as text", sim(control_start="50"), E, ("control_start", "number")),
     Bad("vessel that is not a Vessel", lambda: phsplit.simulate({"mass": 1.0}), E, ("vessel", "phsplit.Vessel")),
     # initial state
     Bad("initial Euler angles with two entries", sim(initial={"euler": [0.0, 0.0]}), E, ("euler", "3 components")),
     Bad("unknown initial-state field", sim(initial={"speed": [1.0, 0.0, 0.0]}), E, ("speed", "allowed")),
     Bad("flat initial state of the wrong length", sim(initial=np.zeros(26)), E, ("27", "got 26")),
-    Bad("NaN in the initial state", initial_with(18, math.nan), E, ("initial state", "finite")),
+    Bad("NaN in the initial state", initial_with(18, math.nan), E, ("initial state", "finite", "entry 18 (x)")),
+    Bad("flat initial state given as a matrix", sim(initial=np.zeros((3, 9))), E, ("1-D", "(3, 9)")),
+    Bad("reflection as initial attitude, projected", lambda: phsplit.simulate(
+        phsplit.Vessel.paper(), (0.0, 1.0), 0.5, initial=_reflected(), orthonormalize=True), E, ("det Q", "reflection")),
     Bad("initial attitude that is not a rotation", initial_with(slice(6, 15), 2 * np.eye(3).reshape(-1)), E,
         ("attitude", "not a rotation", "orthonormalize")),
     # scenario files
@@ -124,4 +148,8 @@ CATALOGUE: list[Bad] = [
     Bad("scenario vessel file missing", scenario('vessel = "nowhere.toml"\n[simulation]\nh = 1.0\n'), E,
         ("nowhere.toml", "cannot read")),
     Bad("scenario TOML syntax error", scenario("[simulation\nh = 1\n"), P, ("line", "column")),
+    Bad("scenario controller start as a list", scenario("[simulation]\ncontrol_start = [1.0]\n"), P,
+        ("simulation.control_start", "never")),
+    Bad("scenario gain that is not a gain", scenario("[control]\nkp_translational = [-1.0, 0.0, 0.0]\n"), E,
+        ("control.kp_translational[0]", "≥ 0")),
 ]

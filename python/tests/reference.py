@@ -1,9 +1,10 @@
-"""An independent reference for the vessel: eq. (39) of the paper written again in numpy, from
-MODEL.md §2, and integrated by scipy's DOP853 at tight tolerance.
+"""An independent reference for the vessel, for the tests: eq. (39) of the paper written again in
+numpy, from docs/model.md §2 (and the external load of §5), integrated by scipy's DOP853 at
+tight tolerance.
 
 Nothing here calls phsplit's integrators or its Rust vector field; only the initial state and
-the parameters are shared. The tests and ``phsplit reproduce`` use it to check the splitting
-methods against a computation that shares no code with them."""
+the parameters are shared. The tests use it to check the splitting methods against a
+computation that shares no code with them."""
 from __future__ import annotations
 
 import numpy as np
@@ -46,6 +47,20 @@ class Field:
         self.xr = np.array(c["position_reference"])
         self.thr = np.array(c["euler_reference"])
         self.on = control_on
+        ext = params.get("external")
+        self.ext = None
+        if ext:
+            self.ext = (np.array(ext.get("force", [0.0] * 3), float), np.array(ext.get("moment", [0.0] * 3), float),
+                        np.array(ext.get("point", [0.0] * 3), float), ext.get("frame", "body"))
+
+    def external(self, Q):
+        """Body-frame force and moment (about the body origin) of the constant external load."""
+        if self.ext is None:
+            return np.zeros(3), np.zeros(3)
+        f, m, r, frame = self.ext
+        if frame == "spatial":
+            f, m = Q.T @ f, Q.T @ m
+        return f, m + np.cross(r, f)
 
     def __call__(self, t, y):
         p, m, Q = y[0:3], y[3:6], y[6:15].reshape(3, 3, order="F")
@@ -59,9 +74,10 @@ class Field:
                         + K["ki_translational"] @ phx)
         tau_r = -W.T @ (K["kp_rotational"] @ (th - self.thr) + K["kd_rotational"] @ W @ w
                         + K["ki_rotational"] @ phth)
+        fe, me = self.external(Q)
         dy = np.empty(27)
-        dy[0:3] = -np.cross(w, p) - (self.Dt * v + Q.T @ (self.lam * x) - tau_t)
-        dy[3:6] = -np.cross(w, m) - (self.Dr * w + np.cross(mu, q3) - tau_r)
+        dy[0:3] = -np.cross(w, p) - (self.Dt * v + Q.T @ (self.lam * x) - tau_t) + fe
+        dy[3:6] = -np.cross(w, m) - (self.Dr * w + np.cross(mu, q3) - tau_r) + me
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)
         dy[18:21] = Q @ v

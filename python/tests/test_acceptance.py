@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import phsplit
-from phsplit import reference as ref
+import reference as ref
 
 VESSEL = phsplit.Vessel.paper()
 PARAMS = VESSEL.to_dict()

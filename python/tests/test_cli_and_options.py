@@ -125,7 +125,7 @@ def test_diverging_runs_end_promptly_with_finite_output():
 
 def test_vector_field_binding_matches_the_independent_model():
     from phsplit import _core
-    from phsplit import reference as ref
+    import reference as ref
 
     v = phsplit.Vessel.paper()
     y = v.initial_state()

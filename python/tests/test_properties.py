@@ -108,3 +108,19 @@ def test_random_text_as_scenario_file(text):
         with open(p, "w", encoding="utf-8") as f:
             f.write(text)
         _only_documented_errors(scn.load, p)
+
+
+def test_regression_rotation_within_round_off_of_the_middle_axis():
+    """Found by the property above: yaw is the middle axis of this vessel, and a yaw rotation
+    with pitch rate 1e-151 rad/s put flow S1 on the separatrix within round-off (k² = 1,
+    sn ν = 1), where the direct phase F(π/2 | 1) is infinite; the run used to fail."""
+    d = phsplit.Vessel.paper().to_dict()
+    d["vessel"]["inertia"] = [143653550.0, 10223036250.0, 3987500000.0]
+    d["vessel"]["damping_translational"] = [0.0, 0.0, 0.0]
+    d["vessel"]["damping_rotational"] = [9329153.987, 651497912.7508227, 384021622.46175]
+    v = phsplit.Vessel.from_dict(d)
+    s = phsplit.simulate(v, (0.0, 90.0), 3.0, "lie", control_start=0.0, linear_flow="exact",
+                         initial={"euler": [0.0, 0.0, 0.0], "angular_velocity": [0.0, 1.1e-312, 0.0]})
+    assert s.status == "completed"
+    scale = s.energy[0] + np.abs(s.ledger.supplied).sum() + s.ledger.dissipated.sum()
+    assert np.abs(s.ledger.residual).max() <= 1e-9 * scale

@@ -20,7 +20,9 @@ from ._core import (
 )
 from ._core import method_info as _method_info
 from .batch import simulate_many, with_parameters
-from .simulate import Ledger, PassivityWarning, Solution, Vessel, simulate
+from .scenario import Scenario
+from .scenario import load as load_scenario
+from .simulate import Ledger, PassivityWarning, Settings, Solution, Vessel, simulate
 
 
 def method_info(name: str) -> dict:
@@ -35,10 +37,13 @@ __all__ = [
     "Ledger",
     "PassivityWarning",
     "PhsplitError",
+    "Scenario",
     "ScenarioParseError",
+    "Settings",
     "Solution",
     "Vessel",
     "__version__",
+    "load_scenario",
     "method_info",
     "simulate",
     "simulate_many",

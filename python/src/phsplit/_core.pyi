@@ -1,11 +1,15 @@
-"""Type stub of the native module phsplit._core (Rust, PyO3)."""
-from typing import Any
+"""Type stub of the native module phsplit._core (Rust, PyO3). Every option and parameter is
+parsed and validated by the core; this module only converts values."""
+from typing import Any, Mapping
 
 import numpy as np
 import numpy.typing as npt
 
 METHODS: list[str]
+OUTER: list[str]
+LINEAR_FLOWS: list[str]
 MAX_STEPS: int
+STATE_DIM: int
 __version__: str
 
 class PhsplitError(Exception): ...
@@ -19,8 +23,12 @@ class Vessel:
     @staticmethod
     def from_toml_str(text: str) -> Vessel: ...
     @staticmethod
+    def from_dict(d: Mapping[str, Any]) -> Vessel: ...
+    @staticmethod
     def paper_toml() -> str: ...
-    def to_dict(self) -> dict[str, dict[str, Any]]: ...
+    def to_dict(self) -> dict[str, Any]: ...
+    def components(self) -> list[str]: ...
+    def accounts(self) -> list[tuple[str, str]]: ...
     def energy(self, state: npt.NDArray[np.float64]) -> float: ...
     def initial_state(
         self,
@@ -37,18 +45,14 @@ class VectorField:
     def __call__(self, t: float, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
     def into(self, t: float, y: npt.NDArray[np.float64], out: npt.NDArray[np.float64]) -> None: ...
 
+def default_settings() -> dict[str, Any]: ...
+def check_settings(d: Mapping[str, Any], api: bool = ...) -> dict[str, Any]: ...
+def settings_keys() -> list[tuple[str, str]]: ...
+def vessel_tables() -> list[str]: ...
 def integrate(
     vessel: Vessel,
-    t0: float,
-    h: float,
-    n_steps: int,
-    method: str,
-    control_start: float | None,
-    outer: str,
-    save_every: int,
-    ledger: bool,
-    state0: npt.NDArray[np.float64],
-    linear_flow: str = ...,
+    settings: Mapping[str, Any],
+    state0: npt.NDArray[np.float64] | None = ...,
     orthonormalize: bool = ...,
 ) -> dict[str, Any]: ...
 def method_info(name: str) -> dict[str, Any]: ...

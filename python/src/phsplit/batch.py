@@ -33,95 +33,53 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from . import _core
-from .simulate import Vessel, simulate
+from .simulate import Settings, Vessel, simulate
 
-_PATH = re.compile(r"^(vessel|control|initial)\.([a-z_]+)(?:\[([0-2])\])?$")
-
-
-def _toml_text(d: dict) -> str:
-    lines = []
-    for section in ("vessel", "control", "initial"):
-        lines.append(f"[{section}]")
-        for k, v in d[section].items():
-            if isinstance(v, (list, tuple)):
-                lines.append(f"{k} = [{', '.join(repr(float(x)) for x in v)}]")
-            else:
-                lines.append(f"{k} = {float(v)!r}")
-    return "\n".join(lines)
+_PATH = re.compile(r"^([a-z_]+)\.([a-z_]+)(?:\[([0-9]+)\])?$")
 
 
 def _resolve(d: dict, key: str) -> tuple[str, str, int | None]:
-    """Check a parameter path against a vessel's dict: (section, name, index or None)."""
+    """Check a parameter path against a vessel's dict: (table, name, index or None)."""
     m = _PATH.match(key)
-    if not m or m.group(2) not in d[m.group(1)]:
-        valid = sorted(f"{s}.{k}" for s in d for k in d[s])
+    if not m or not isinstance(d.get(m.group(1)), dict) or m.group(2) not in d[m.group(1)]:
+        valid = sorted(f"{s}.{k}" for s in d if isinstance(d[s], dict) for k in d[s])
         raise _core.InvalidInputError(
-            f"unknown parameter {key!r}; parameters are section.name or section.name[i], one of: {', '.join(valid)}")
+            f"unknown parameter {key!r}; parameters are table.name or table.name[i], one of: {', '.join(valid)}")
     sec, name, idx = m.group(1), m.group(2), m.group(3)
-    is_vec = isinstance(d[sec][name], (list, tuple))
+    cur = d[sec][name]
+    is_vec = isinstance(cur, (list, tuple))
     if is_vec and idx is None:
-        raise _core.InvalidInputError(f"parameter {key!r} is a 3-vector: give an index, e.g. {key}[0]")
+        raise _core.InvalidInputError(f"parameter {key!r} is a {len(cur)}-vector: give an index, e.g. {key}[0]")
     if not is_vec and idx is not None:
         raise _core.InvalidInputError(f"parameter {sec}.{name} is a scalar: drop the index in {key!r}")
+    if is_vec and int(idx) >= len(cur):
+        raise _core.InvalidInputError(f"parameter {key!r}: index out of range (0..{len(cur) - 1})")
     return sec, name, None if idx is None else int(idx)
 
 
 def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
-    """``base`` with parameters replaced: keys ``section.name`` or ``section.name[i]``, sections
-    ``vessel``, ``control``, ``initial``. Unknown paths and bad values raise InvalidInputError."""
+    """``base`` with parameters replaced: keys ``table.name`` or ``table.name[i]`` of the vessel
+    file (``vessel``, ``control``, ``initial``, ``external``, …). Unknown paths and bad values
+    raise InvalidInputError."""
     d = base.to_dict()
     for key, value in params.items():
         sec, name, idx = _resolve(d, key)
         if idx is None:
             d[sec][name] = float(value)
         else:
-            cur = list(d[sec][name])
-            cur[idx] = float(value)
-            d[sec][name] = cur
-    v = Vessel.from_toml_str(_toml_text(d))
-    v.source = f"{base.source} with {dict(params)}"
-    return v
-
-
-@dataclass
-class Settings:
-    """Simulation settings shared by every case of a batch or sweep."""
-
-    t_span: tuple[float, float] = (0.0, 200.0)
-    h: float = 0.5
-    method: str = "sp2"
-    control_start: float | None = 50.0
-    outer: str = "dissipative"
-    save_every: int = 1
-    linear_flow: str = "exact"
-
-    def run(self, vessel: Vessel):
-        return simulate(vessel, self.t_span, self.h, self.method, self.control_start, outer=self.outer,
-                        save_every=self.save_every, linear_flow=self.linear_flow)
+            d[sec][name][idx] = float(value)
+    return Vessel.from_dict(d, f"{base.source} with {dict(params)}")
 
 
 def summarize(vessel: Vessel, sol) -> dict[str, Any]:
-    """Per-case summary: final distances to the set point, energy, peak control effort, status."""
-    from . import reference as ref
-
+    """Per-case summary: final distances to the set point, energy, peak control effort (the
+    controller's force and moment as the core computes them, at the saved states), status."""
     c = vessel.to_dict()["control"]
     xr_, er = np.asarray(c["position_reference"]), np.asarray(c["euler_reference"])
-    params = vessel.to_dict()
-    f_on = ref.Field(params, True)
     peak_t = peak_r = 0.0
     if len(sol.t):
-        for i in range(0, len(sol.t), max(1, len(sol.t) // 400)):
-            if sol.control_start is None or sol.t[i] < sol.control_start:
-                continue
-            y = np.concatenate([sol.p[i], sol.m[i], sol.Q[i].reshape(-1, order="F"), sol.mu[i], sol.x[i],
-                                sol.phi_th[i], sol.phi_x[i]])
-            peak_r = max(peak_r, float(np.linalg.norm(f_on.control_torque(y))))
-            v = sol.p[i] / params["vessel"]["mass"]
-            K = f_on.K
-            Q = sol.Q[i]
-            tau_t = -Q.T @ (K["kp_translational"] @ (sol.x[i] - xr_) + K["kd_translational"] @ Q @ v
-                            + K["ki_translational"] @ sol.phi_x[i])
-            peak_t = max(peak_t, float(np.linalg.norm(tau_t)))
+        peak_t = float(np.max(np.linalg.norm(sol.control_force, axis=1)))
+        peak_r = float(np.max(np.linalg.norm(sol.control_moment, axis=1)))
     bound = 100.0 * (sol.energy[0] + max(0.0, float(np.sum(sol.ledger.supplied))))
     diverged = sol.status != "completed" or not np.all(np.isfinite(sol.energy)) or float(np.max(sol.energy)) > bound
     return {
@@ -247,15 +205,8 @@ def load_sweep(path: str) -> Sweep:
                                            + (f"; did you mean {near[0]!r}?" if near else "")
                                            + f" (allowed: {', '.join(SWEEP_KEYS)})")
     # the rest is a scenario
-    with tempfile.NamedTemporaryFile("w", suffix=".toml", dir=os.path.dirname(os.path.abspath(path)),
-                                     delete=False) as tmp:
-        tmp.write(_dump_scenario(data))
-    try:
-        sc = scn.load(tmp.name)
-    finally:
-        os.unlink(tmp.name)
-    settings = Settings(t_span=sc.t_span, h=sc.h, method=sc.method, control_start=sc.control_start,
-                        outer=sc.outer, save_every=sc.save_every)
+    sc = scn.from_dict(data, path)
+    settings = sc.settings
     params = sw.get("parameters", {})
     if not isinstance(params, dict) or not params:
         raise _core.ScenarioParseError(f"{path}: [sweep.parameters] must list at least one parameter")
@@ -292,23 +243,9 @@ def load_sweep(path: str) -> Sweep:
                  name=os.path.splitext(os.path.basename(path))[0])
 
 
-def _dump_scenario(data: dict) -> str:
-    from .scenario import _toml_value
-
-    out = []
-    for k, v in data.items():
-        if not isinstance(v, dict):
-            out.append(f"{k} = {_toml_value(v)}")
-    for k, v in data.items():
-        if isinstance(v, dict):
-            out.append(f"[{k}]")
-            out += [f"{kk} = {_toml_value(vv)}" for kk, vv in v.items()]
-    return "\n".join(out) + "\n"
-
-
-def _run_case(base_toml: str, settings: Settings, case: dict) -> dict:
+def _run_case(base_tables: dict, settings: Settings, case: dict) -> dict:
     """Run one case (on a Dask worker). Returns plain data: arrays and the summary, or the error."""
-    base = Vessel.from_toml_str(base_toml)
+    base = Vessel.from_dict(base_tables)
     try:
         v = with_parameters(base, case)
     except (_core.InvalidInputError, _core.ScenarioParseError) as e:
@@ -375,8 +312,8 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                                    processes=True, host="127.0.0.1", dashboard_address=None)
             client = Client(cluster, set_as_default=False)
         try:
-            base_toml = _toml_text(sweep.base.to_dict())
-            futures = {client.submit(_run_case, base_toml, sweep.settings, sweep.cases[i], key=ids[i],
+            base_tables = sweep.base.to_dict()
+            futures = {client.submit(_run_case, base_tables, sweep.settings, sweep.cases[i], key=ids[i],
                                      retries=retries, pure=False): ids[i] for i in todo}
             with tqdm(total=len(ids), initial=len(ids) - len(todo), unit="case", disable=not progress) as bar:
                 for fut in as_completed(futures, loop=client.loop):

@@ -11,6 +11,7 @@ EXAMPLES = """examples:
   phsplit simulate                         # the paper's Fig. 2 scenario (SP4, h = 0.5, [0, 200])
   phsplit simulate scenario.toml --out runs/
   phsplit simulate --method sp2 --h 0.25 --t-end 400
+  phsplit simulate --control-start never   # the controller off throughout
   phsplit methods                          # methods with order, stages and passivity guarantee
   phsplit reproduce --out paper/           # the paper's Figs. 2-4, stability sweep and report
   phsplit reproduce --quick                # the same in a few seconds, with coarser references
@@ -42,8 +43,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--h", type=float, help="override the step size, s")
     s.add_argument("--t-end", type=float, help="override the end time, s")
     s.add_argument("--save-every", type=int, help="save every k-th step (decimation)")
-    s.add_argument("--linear-flow", choices=["exact", "gauss"], default="exact",
-                   help="flow S2 exactly (matrix exponentials) or by Gauss collocation (faster)")
+    s.add_argument("--control-start", help="override the controller's start time, s, or 'never'")
+    s.add_argument("--linear-flow", choices=["exact", "gauss"],
+                   help="flow S2 exactly (matrix exponentials, the default) or by Gauss collocation (faster)")
     s.add_argument("--no-plot", action="store_true", help="skip the PNG")
     sub.add_parser("methods", help="list the integration methods")
     r = sub.add_parser(
@@ -91,36 +93,72 @@ def _chunks(n: int, save_every: int, target: int = 100, min_steps: int = 20_000)
     return out
 
 
-def _simulate(args) -> int:
-    import numpy as np
+class _DeferSignals:
+    """Hold SIGINT and SIGTERM while a chunk is written and booked, then act on them: an
+    interrupt never lands inside the NetCDF writer or between writing rows and counting them."""
 
+    def __enter__(self):
+        import signal
+
+        self.got = None
+        self.old = {}
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self.old[sig] = signal.signal(sig, self._hold)
+        return self
+
+    def _hold(self, signum, frame):
+        self.got = signum
+
+    def __exit__(self, *exc):
+        import signal
+
+        for sig, h in self.old.items():
+            signal.signal(sig, h)
+        if self.got is not None and exc[0] is None:
+            raise KeyboardInterrupt
+        return False
+
+
+def _simulate(args) -> int:
     import phsplit
     from . import scenario as scn
     from .plotting import plot_positions, publish, reference_of
 
     sc = scn.load(args.scenario) if args.scenario else scn.Scenario.paper_fig2()
+    over = {}
     if args.method:
-        sc.method = args.method
+        over["method"] = args.method
     if args.h is not None:
-        sc.h = args.h
+        over["h"] = args.h
     if args.t_end is not None:
-        sc.t_span = (sc.t_span[0], args.t_end)
+        over["t_span"] = (sc.t_span[0], args.t_end)
     if args.save_every is not None:
-        sc.save_every = args.save_every
+        over["save_every"] = args.save_every
+    if args.linear_flow is not None:
+        over["linear_flow"] = args.linear_flow
+    if args.control_start is not None:
+        if args.control_start == "never":
+            over["control_start"] = None
+        else:
+            try:
+                over["control_start"] = float(args.control_start)
+            except ValueError:
+                raise UsageError(f"--control-start must be a time in s or 'never', got {args.control_start!r}") from None
+    sc = sc.replace(**over)
     out = args.out
+    # Validate everything (and learn the step count) before any file is touched.
+    n = sc.settings.checked()["n_steps"]
     try:
         os.makedirs(out, exist_ok=True)
     except OSError as e:
         raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
     if not os.access(out, os.W_OK):
         raise UsageError(f"output folder {out!r} is not writable")
-    # Validate everything (and learn the step count) before any file is touched.
     t0, t1 = sc.t_span
-    phsplit.simulate(sc.vessel, (t0, t0 + sc.h), sc.h, sc.method, control_start=sc.control_start,
-                     outer=sc.outer, save_every=1, linear_flow=args.linear_flow)
-    n = int(np.floor((t1 - t0) / sc.h * (1 + 1e-12)))
+    ctl = "never" if sc.control_start is None else f"t={sc.control_start:g} s"
     print(f"phsplit {phsplit.__version__}: {sc.name}: {sc.method} h={sc.h:g} s on "
-          f"[{t0:g}, {t1:g}] s ({n} steps), controller from t={sc.control_start}", flush=True)
+          f"[{t0:g}, {t1:g}] s ({n} steps), controller from {ctl}; components: "
+          f"{', '.join(sc.vessel.components)}", flush=True)
     nc = os.path.join(out, f"{sc.name}.nc")
     part = nc + ".part"
     t_start = time.perf_counter()
@@ -130,18 +168,20 @@ def _simulate(args) -> int:
     status = "completed"
     sols = []
     nc_file = None
+    from dataclasses import replace
+
     from tqdm import tqdm
 
     bar = tqdm(total=n, unit="step", unit_scale=True, disable=not (sys.stderr.isatty() and n > 20_000), leave=False)
     try:
         for k in _chunks(n, sc.save_every):
-            sol = phsplit.simulate(sc.vessel, (t, t + k * sc.h), sc.h, sc.method, control_start=sc.control_start,
-                                   outer=sc.outer, save_every=sc.save_every, initial=state,
-                                   linear_flow=args.linear_flow)
-            nc_file = _append(nc_file, part, sol, first=(done == 0), scenario=args.scenario)
-            sols.append(sol)
-            done += sol.steps
-            bar.update(sol.steps)
+            sol = phsplit.simulate(sc.vessel, initial=state,
+                                   settings=replace(sc.settings, t_span=(t, t + k * sc.h)))
+            with _DeferSignals():
+                nc_file = _append(nc_file, part, sol, first=(done == 0), scenario=args.scenario)
+                sols.append(sol)
+                done += sol.steps
+                bar.update(sol.steps)
             if sol.status != "completed":
                 status = "failed"
                 break
@@ -151,13 +191,14 @@ def _simulate(args) -> int:
         status = "interrupted"
     finally:
         bar.close()
-        if nc_file is not None:
-            nc_file.setncattr("status", status)
-            nc_file.setncattr("steps", done)
-            nc_file.close()
-            publish(part, nc)
-        elif os.path.exists(part):
-            os.unlink(part)
+        with _DeferSignals():
+            if nc_file is not None:
+                nc_file.setncattr("status", status)
+                nc_file.setncattr("steps", done)
+                nc_file.close()
+                publish(part, nc)
+            elif os.path.exists(part):
+                os.unlink(part)
     dt = time.perf_counter() - t_start
     if status == "interrupted":
         if sols:
@@ -177,6 +218,8 @@ def _simulate(args) -> int:
     print(f"t = {last.t[-1]:g} s: x = ({last.x[-1, 0]:.3f}, {last.x[-1, 1]:.3f}, {last.x[-1, 2]:.4f}) m, "
           f"roll/pitch/yaw = ({e[0]:.5f}, {e[1]:.5f}, {e[2]:.5f}) rad")
     print(f"energy H: {sols[0].energy[0]:.6e} -> {last.energy[-1]:.6e} J; worst relative ledger residual {rr:.2e}")
+    booked = {a: sum(float(s_.ledger.by_account[a].sum()) for s_ in sols) for a in last.ledger.by_account}
+    print("ledger, J: " + ", ".join(f"{a} {last.ledger.kinds[a]} {v:.6e}" for a, v in booked.items()))
     for f in files:
         print(f"wrote {os.path.abspath(f)}")
     if status != "completed":

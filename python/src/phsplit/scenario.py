@@ -1,8 +1,12 @@
 """Scenario files (TOML): what to simulate, validated with messages that name the problem.
 
-A scenario has a ``[simulation]`` table and optionally a vessel, either as a path
-(``vessel = "my_vessel.toml"``, relative to the scenario file) or inline as the ``[vessel]``,
-``[control]`` and ``[initial]`` tables of a vessel file. Without a vessel, the paper's is used.
+A scenario has a ``[simulation]`` table (every key optional; the defaults are the paper's
+Fig. 2 run, shared with :func:`phsplit.simulate`) and optionally a vessel: a path
+(``vessel = "my_vessel.toml"``, relative to the scenario file) or the paper's when absent.
+Any table of a vessel file given in the scenario (``[vessel]``, ``[control]``, ``[initial]``,
+``[external]``, …) overrides that vessel key by key, so one gain or one load can be changed
+without copying the vessel file. Every key either acts or is refused: the core reads the
+settings and the vessel, and names a key nobody reads, with the nearest valid one.
 
 .. code-block:: toml
 
@@ -10,130 +14,125 @@ A scenario has a ``[simulation]`` table and optionally a vessel, either as a pat
     t_span = [0.0, 200.0]   # s
     h = 0.5                 # s
     method = "sp4"          # lie, sp2, sp4, sp6, euler, heun, rk4
-    control_start = 50.0    # s; omit for no control
+    control_start = 50.0    # s, or "never"
     outer = "dissipative"   # or "conservative"
     save_every = 1
+    linear_flow = "exact"   # or "gauss"
+
+    [external]              # a constant load at a point of the hull
+    force = [2.0e5, 0.0, 0.0]   # N
+    point = [-40.0, 0.0, 5.0]   # m, body frame
+    frame = "spatial"           # or "body"
 """
 from __future__ import annotations
 
+import copy
 import difflib
 import os
 import tomllib
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Mapping
 
 from . import _core
-from .simulate import Vessel
-
-SIMULATION_KEYS = {
-    "t_span": "two numbers [t0, t1], s",
-    "h": "step size, s",
-    "method": "one of " + ", ".join(_core.METHODS),
-    "control_start": "time the controller starts, s",
-    "outer": "'dissipative' or 'conservative'",
-    "save_every": "integer >= 1",
-    "name": "a label for the output files",
-}
-TOP_KEYS = {"simulation", "vessel", "control", "initial"}
+from .simulate import Settings, Vessel
 
 
 @dataclass
 class Scenario:
+    """A vessel, the settings of a run, and a name for its output."""
+
     vessel: Vessel
-    t_span: tuple[float, float] = (0.0, 200.0)
-    h: float = 0.5
-    method: str = "sp4"
-    control_start: float | None = 50.0
-    outer: str = "dissipative"
-    save_every: int = 1
+    settings: Settings = field(default_factory=Settings)
     name: str = "fig2"
-    extra: dict[str, Any] = field(default_factory=dict)
+    path: str | None = None
 
     @classmethod
     def paper_fig2(cls) -> "Scenario":
         """The paper's Fig. 2: t in [0, 200], controller on at t = 50, SP4 with h = 0.5."""
         return cls(vessel=Vessel.paper())
 
+    # The settings, for reading and overriding (the CLI's options).
+    def __getattr__(self, key: str) -> Any:
+        if key in Settings.__dataclass_fields__:
+            return getattr(self.settings, key)
+        raise AttributeError(key)
 
-def _unknown(key: str, allowed: set[str] | dict[str, str], where: str) -> str:
-    near = difflib.get_close_matches(key, list(allowed), n=1)
-    hint = f"; did you mean {near[0]!r}?" if near else ""
-    return f"unknown key {key!r} in {where}{hint} (allowed: {', '.join(sorted(allowed))})"
+    def replace(self, **kw: Any) -> "Scenario":
+        from dataclasses import replace
+
+        return Scenario(self.vessel, replace(self.settings, **kw), self.name, self.path)
 
 
-def _toml_value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, float)):
-        return repr(float(v)) if isinstance(v, float) else str(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
-    raise _core.ScenarioParseError(f"unsupported value {v!r} in a vessel table")
+def overlay(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
+    """``base`` with the tables of ``over`` merged in key by key (a new dict)."""
+    out = copy.deepcopy(dict(base))
+    for k, v in over.items():
+        if isinstance(v, Mapping) and isinstance(out.get(k), Mapping):
+            out[k] = {**out[k], **v}
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def _read_toml(p: str, what: str) -> dict[str, Any]:
+    try:
+        with open(p, "rb") as f:
+            raw = f.read()
+    except FileNotFoundError:
+        raise _core.InvalidInputError(f"{what} {p!r} does not exist") from None
+    except OSError as e:
+        raise _core.InvalidInputError(f"cannot read {what} {p!r}: {e.strerror}") from None
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise _core.ScenarioParseError(f"{p}: not a text file (TOML must be UTF-8)") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise _core.ScenarioParseError(f"{p}: TOML syntax error: {e}") from None
+
+
+def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...] = ()) -> Scenario:
+    """A scenario from its parsed tables; ``path`` names the file in messages and resolves a
+    relative vessel path."""
+    tables = set(_core.vessel_tables())
+    top = {"simulation", "vessel"} | tables | set(allowed_extra)
+    for k in data:
+        if k not in top:
+            near = difflib.get_close_matches(k, sorted(top), n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else ""
+            raise _core.ScenarioParseError(f"{path}: unknown table {k!r} in the scenario{hint} "
+                                           f"(allowed: {', '.join(sorted(top))})")
+    sim = data.get("simulation", {})
+    if not isinstance(sim, Mapping):
+        raise _core.ScenarioParseError(f"{path}: [simulation] must be a table")
+    try:
+        checked = _core.check_settings(dict(sim), api=False)
+    except (_core.ScenarioParseError, _core.InvalidInputError) as e:
+        raise type(e)(f"{path}: {e}") from None
+    settings = Settings(**{k: (tuple(checked[k]) if k == "t_span" else checked[k])
+                           for k in Settings.__dataclass_fields__})
+    v = data.get("vessel")
+    base_dir = os.path.dirname(os.path.abspath(path))
+    if v is None or isinstance(v, Mapping):
+        base, source = Vessel.paper(), "paper"
+    elif isinstance(v, str):
+        base, source = Vessel.from_toml(os.path.join(base_dir, v)), v
+    else:
+        raise _core.ScenarioParseError(f"{path}: 'vessel' must be a file path or a table, got {v!r}")
+    over = {k: val for k, val in data.items() if k in tables and not (k == "vessel" and isinstance(val, str))}
+    if over:
+        try:
+            vessel = Vessel.from_dict(overlay(base.to_dict(), over), f"{source} with the tables of {path}")
+        except (_core.ScenarioParseError, _core.InvalidInputError) as e:
+            raise type(e)(f"{path}: {e}") from None
+    else:
+        vessel = base
+    name = checked.get("name") or os.path.splitext(os.path.basename(path))[0]
+    return Scenario(vessel=vessel, settings=settings, name=name, path=path)
 
 
 def load(path: str | os.PathLike[str]) -> Scenario:
     """Read and validate a scenario file."""
     p = os.fspath(path)
-    try:
-        with open(p, "rb") as f:
-            data = tomllib.load(f)
-    except FileNotFoundError:
-        raise _core.InvalidInputError(f"scenario file {p!r} does not exist") from None
-    except OSError as e:
-        raise _core.InvalidInputError(f"cannot read scenario file {p!r}: {e.strerror}") from None
-    except tomllib.TOMLDecodeError as e:
-        raise _core.ScenarioParseError(f"{p}: TOML syntax error: {e}") from None
-    for k in data:
-        if k not in TOP_KEYS:
-            raise _core.ScenarioParseError(f"{p}: " + _unknown(k, TOP_KEYS, "the scenario"))
-    sim = data.get("simulation", {})
-    if not isinstance(sim, dict):
-        raise _core.ScenarioParseError(f"{p}: [simulation] must be a table")
-    for k in sim:
-        if k not in SIMULATION_KEYS:
-            raise _core.ScenarioParseError(f"{p}: " + _unknown(k, SIMULATION_KEYS, "[simulation]"))
-    v = data.get("vessel")
-    base = os.path.dirname(os.path.abspath(p))
-    if v is None:
-        vessel = Vessel.paper()
-    elif isinstance(v, str):
-        vessel = Vessel.from_toml(os.path.join(base, v))
-    elif isinstance(v, dict):
-        text = []
-        for section in ("vessel", "control", "initial"):
-            table = data.get(section)
-            if not isinstance(table, dict):
-                raise _core.ScenarioParseError(
-                    f"{p}: an inline vessel needs the tables [vessel], [control] and [initial]; [{section}] is missing"
-                )
-            text.append(f"[{section}]")
-            text.extend(f"{key} = {_toml_value(val)}" for key, val in table.items())
-        try:
-            vessel = Vessel.from_toml_str("\n".join(text))
-        except (_core.ScenarioParseError, _core.InvalidInputError) as e:
-            raise type(e)(f"{p}: {e}") from None
-        vessel.source = p
-    else:
-        raise _core.ScenarioParseError(f"{p}: 'vessel' must be a file path or a table")
-    sc = Scenario(vessel=vessel)
-    name = os.path.splitext(os.path.basename(p))[0]
-    sc.name = str(sim.get("name", name))
-    if "t_span" in sim:
-        ts = sim["t_span"]
-        if not (isinstance(ts, list) and len(ts) == 2 and all(isinstance(x, (int, float)) for x in ts)):
-            raise _core.ScenarioParseError(f"{p}: simulation.t_span must be two numbers [t0, t1] in s, got {ts!r}")
-        sc.t_span = (float(ts[0]), float(ts[1]))
-    for key, typ in (("h", (int, float)), ("control_start", (int, float)), ("save_every", int),
-                     ("method", str), ("outer", str)):
-        if key in sim:
-            val = sim[key]
-            if not isinstance(val, typ) or isinstance(val, bool):
-                raise _core.ScenarioParseError(
-                    f"{p}: simulation.{key} must be {SIMULATION_KEYS[key]}, got {val!r}"
-                )
-            setattr(sc, key, float(val) if typ == (int, float) else val)
-    if "control_start" not in sim and "simulation" in data:
-        sc.control_start = None
-    return sc
+    return from_dict(_read_toml(p, "scenario file"), p)

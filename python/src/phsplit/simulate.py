@@ -11,7 +11,6 @@ import numpy as np
 
 from . import _core
 
-_OUTER = ("dissipative", "conservative")
 
 
 class PassivityWarning(UserWarning):
@@ -20,11 +19,13 @@ class PassivityWarning(UserWarning):
 
 
 class Vessel:
-    """A vessel: hull data, PID controller and default initial state (SI units).
+    """A vessel: rigid body, forces and ports (components), default initial state (SI units).
 
-    ``Vessel.paper()`` is the paper's vessel (Appendix D, reconstructed in MODEL.md §3);
-    ``Vessel.from_toml(path)`` reads a file with sections ``[vessel]``, ``[control]``,
-    ``[initial]`` (the paper's file, ``Vessel.paper_toml()``, is the template).
+    ``Vessel.paper()`` is the paper's vessel (Appendix D; docs/model.md §4);
+    ``Vessel.from_toml(path)`` reads a file with tables ``[vessel]``, ``[control]``,
+    ``[initial]`` and optional components such as ``[external]`` (the paper's file,
+    ``Vessel.paper_toml()``, is the template); ``Vessel.from_dict(d)`` takes the same tables as a
+    mapping (``to_dict()`` gives them back, with defaults filled in).
     """
 
     __slots__ = ("_inner", "source")
@@ -41,21 +42,37 @@ class Vessel:
     def from_toml(cls, path: str | os.PathLike[str]) -> "Vessel":
         p = os.fspath(path)
         try:
-            with open(p, encoding="utf-8") as f:
+            with open(p, encoding="utf-8-sig") as f:
                 text = f.read()
         except OSError as e:
             raise _core.InvalidInputError(f"cannot read vessel file {p!r}: {e.strerror}") from None
+        except UnicodeDecodeError:
+            raise _core.ScenarioParseError(f"{p}: not a text file (TOML must be UTF-8)") from None
         try:
             return cls(_core.Vessel.from_toml_str(text), p)
-        except _core.ScenarioParseError as e:
-            raise _core.ScenarioParseError(f"{p}: {_suggest(str(e))}") from None
+        except (_core.ScenarioParseError, _core.InvalidInputError) as e:
+            raise type(e)(f"{p}: {e}") from None
 
     @classmethod
     def from_toml_str(cls, text: str) -> "Vessel":
-        try:
-            return cls(_core.Vessel.from_toml_str(text), "<string>")
-        except _core.ScenarioParseError as e:
-            raise _core.ScenarioParseError(_suggest(str(e))) from None
+        return cls(_core.Vessel.from_toml_str(text), "<string>")
+
+    @classmethod
+    def from_dict(cls, tables: Mapping[str, Any], source: str = "<dict>") -> "Vessel":
+        """A vessel from a mapping of the tables of a vessel file (as ``to_dict()`` returns)."""
+        if not isinstance(tables, Mapping):
+            raise _core.InvalidInputError(f"a vessel is a mapping of tables, got {type(tables).__name__}")
+        return cls(_core.Vessel.from_dict(dict(tables)), source)
+
+    @property
+    def components(self) -> list[str]:
+        """The vessel's force components (ports), in the order they are assembled."""
+        return self._inner.components()
+
+    @property
+    def accounts(self) -> list[tuple[str, str]]:
+        """The ledger's accounts: ``(name, "supplied" | "dissipated")``."""
+        return self._inner.accounts()
 
     @staticmethod
     def paper_toml() -> str:
@@ -63,6 +80,7 @@ class Vessel:
         return _core.Vessel.paper_toml()
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
+        """Every parameter as read, defaults filled in: the tables of a vessel file."""
         return self._inner.to_dict()
 
     def energy(self, state: np.ndarray) -> float:
@@ -85,19 +103,6 @@ class Vessel:
         return f"<phsplit.Vessel {self.source or 'custom'}: {self._inner!r}>"
 
 
-def _suggest(message: str) -> str:
-    """Add the nearest valid key to the parser's "unknown field `x`, expected one of ..."."""
-    import difflib
-    import re
-
-    m = re.search(r"unknown field `([^`]*)`, expected (?:one of )?(.*)", message)
-    if not m:
-        return message
-    valid = re.findall(r"`([^`]*)`", m.group(2))
-    near = difflib.get_close_matches(m.group(1), valid, n=1)
-    return message.rstrip() + (f"; did you mean '{near[0]}'?" if near else "")
-
-
 def _vec3(name: str, v: Any) -> list[float]:
     a = np.asarray(v, dtype=float)
     if a.shape != (3,):
@@ -109,15 +114,19 @@ def _vec3(name: str, v: Any) -> list[float]:
 class Ledger:
     """Energy balance per saved interval (J): ``dH = supplied - dissipated + residual``.
 
-    ``supplied`` is the work of the port (the P and I control terms, ``∫ ν·τ dt``);
-    ``dissipated`` is ``∫ νᵀDν dt`` with D the hydrodynamic damping plus the derivative control
-    terms. For splitting methods both are exact along the sub-flows; for Runge–Kutta methods they
-    are the method's own quadrature of the power. The first entry (no interval) is zero.
+    ``by_account`` holds what each component booked: the work of each port (``control``: the
+    P and I control terms; ``external``: a constant load; ``∫ ν·τ dt``), and each dissipation
+    (``damping``: hydrodynamic; ``control_damping``: the derivative control terms;
+    ``∫ νᵀDν dt ≥ 0``). ``supplied`` and ``dissipated`` are their totals. For splitting
+    methods all are exact along the sub-flows; for Runge–Kutta methods they are the method's
+    own quadrature of the power. The first entry (no interval) is zero.
     """
 
     dH: np.ndarray
     supplied: np.ndarray
     dissipated: np.ndarray
+    by_account: dict[str, np.ndarray] = field(default_factory=dict)
+    kinds: dict[str, str] = field(default_factory=dict)
 
     @property
     def residual(self) -> np.ndarray:
@@ -164,6 +173,35 @@ class Solution:
     failure: str | None = None
     last_good_state: np.ndarray | None = None
     meta: dict[str, Any] = field(default_factory=dict)
+    account_force: np.ndarray | None = None
+    account_moment: np.ndarray | None = None
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def force(self, *accounts: str) -> np.ndarray:
+        """Body-frame force (N, 3) of the named ledger accounts, summed (all when none given)."""
+        return self._by_account(self.account_force, accounts)
+
+    def moment(self, *accounts: str) -> np.ndarray:
+        """Body-frame moment (N, 3) about the body origin of the named accounts, summed."""
+        return self._by_account(self.account_moment, accounts)
+
+    def _by_account(self, arr, accounts) -> np.ndarray:
+        names = list(self.ledger.by_account)
+        unknown = [a for a in accounts if a not in names]
+        if unknown:
+            raise _core.InvalidInputError(f"unknown ledger account(s) {unknown}; this run has {names}")
+        idx = [names.index(a) for a in accounts] if accounts else list(range(len(names)))
+        return arr[:, idx, :].sum(axis=1)
+
+    @property
+    def control_force(self) -> np.ndarray:
+        """The controller's force (P, I and D terms), body frame (N, 3), N."""
+        return self.force(*[a for a in ("control", "control_damping") if a in self.ledger.by_account])
+
+    @property
+    def control_moment(self) -> np.ndarray:
+        """The controller's moment (P, I and D terms), body frame (N, 3), N m."""
+        return self.moment(*[a for a in ("control", "control_damping") if a in self.ledger.by_account])
 
     @property
     def v(self) -> np.ndarray:
@@ -207,11 +245,22 @@ class Solution:
             },
             coords=coords,
         )
+        for k, (name, series) in enumerate(self.ledger.by_account.items()):
+            kind = self.ledger.kinds.get(name, "")
+            ds[f"energy_{name}"] = var(("time",), series, "J", f"energy {kind} by {name} since previous sample")
+            ds[f"force_{name}"] = var(("time", "axis"), self.account_force[:, k, :], "N",
+                                      f"force of {name}, body frame")
+            ds[f"moment_{name}"] = var(("time", "axis"), self.account_moment[:, k, :], "N m",
+                                       f"moment of {name} about the body origin, body frame")
         ds.attrs.update(
             {
                 "title": "phsplit vessel simulation",
                 "method": self.method,
                 "step_size_s": self.h,
+                "outer": str(self.settings.get("outer", "")),
+                "linear_flow": str(self.settings.get("linear_flow", "")),
+                "save_every": int(self.settings.get("save_every", 1)),
+                "components": ", ".join(self.meta.get("components", [])),
                 "control_start_s": "none" if self.control_start is None else self.control_start,
                 "status": self.status,
                 "steps": self.steps,
@@ -244,19 +293,53 @@ def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray) ->
         "'sp2'/'lie', whose positive steps are passive for any h (Prop. 2.2)."), stacklevel=3)
 
 
+_DEFAULTS = _core.default_settings()
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The settings of a run, with the one set of defaults (the core's; the paper's Fig. 2:
+    SP4, h = 0.5 s on [0, 200] s, the controller from t = 50 s) shared by :func:`simulate`,
+    scenario files, :func:`~phsplit.simulate_many` and sweeps. Values are checked by the core
+    when a run starts (or by :meth:`checked`)."""
+
+    t_span: tuple[float, float] = tuple(_DEFAULTS["t_span"])  # type: ignore[assignment]
+    h: float = _DEFAULTS["h"]
+    method: str = _DEFAULTS["method"]
+    control_start: float | None = _DEFAULTS["control_start"]
+    outer: str = _DEFAULTS["outer"]
+    save_every: int = _DEFAULTS["save_every"]
+    linear_flow: str = _DEFAULTS["linear_flow"]
+    ledger: bool = _DEFAULTS["ledger"]
+
+    def as_core(self) -> dict[str, Any]:
+        d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        if d["control_start"] is None:
+            d["control_start"] = "never"
+        return d
+
+    def checked(self) -> dict[str, Any]:
+        """The settings as the core validated them, with the step count ``n_steps``."""
+        return _core.check_settings(self.as_core())
+
+    def run(self, vessel: "Vessel", **kw) -> "Solution":
+        return simulate(vessel, settings=self, **kw)
+
+
 def simulate(
     vessel: Vessel,
-    t_span: tuple[float, float] = (0.0, 200.0),
-    h: float = 0.5,
-    method: str = "sp4",
-    control_start: float | None = 50.0,
+    t_span: tuple[float, float] = Settings.t_span,
+    h: float = Settings.h,
+    method: str = Settings.method,
+    control_start: float | None = Settings.control_start,
     *,
-    outer: str = "dissipative",
-    save_every: int = 1,
-    ledger: bool = True,
+    outer: str = Settings.outer,
+    save_every: int = Settings.save_every,
+    ledger: bool = Settings.ledger,
     initial: np.ndarray | Mapping[str, Sequence[float]] | None = None,
-    linear_flow: str = "exact",
+    linear_flow: str = Settings.linear_flow,
     orthonormalize: bool = False,
+    settings: Settings | None = None,
 ) -> Solution:
     """Simulate the vessel with fixed steps ``h`` over ``t_span``.
 
@@ -271,61 +354,53 @@ def simulate(
     matrix exponentials) or by Gauss collocation of the method's order (``"gauss"``, the
     diagonal Padé approximant: faster, same order, still passive; paper Remark 2.3). An initial
     attitude that is not a rotation is rejected unless ``orthonormalize=True`` asks for its
-    projection to the nearest rotation.
+    projection to the nearest rotation. ``settings`` (a :class:`Settings`) replaces all the
+    settings arguments at once.
 
+    Every setting is validated by the core; a bad one raises ``InvalidInputError`` naming it.
     A run whose state becomes non-finite stops there: ``status == "failed"``, ``failure`` says
     where, the arrays hold what was saved before, ``last_good_state`` the last finite state.
     """
     if not isinstance(vessel, Vessel):
         raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
-    try:
-        t0, t1 = (float(v) for v in t_span)
-    except (TypeError, ValueError):
-        raise _core.InvalidInputError(f"t_span must be two numbers (t0, t1) in s, got {t_span!r}") from None
-    if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
-        raise _core.InvalidInputError(f"t_span must be finite with t1 > t0 (s), got ({t0}, {t1})")
-    h = float(h)
-    if not (math.isfinite(h) and h > 0):
-        raise _core.InvalidInputError(f"h must be finite and > 0 (s), got {h}")
-    if method not in _core.METHODS and method not in ("strang",):
-        raise _core.InvalidInputError(f"unknown method {method!r}; valid methods: {', '.join(_core.METHODS)}")
-    if outer not in _OUTER:
-        raise _core.InvalidInputError(f"outer must be one of {_OUTER}, got {outer!r}")
-    if not isinstance(save_every, (int, np.integer)) or save_every < 1:
-        raise _core.InvalidInputError(f"save_every must be an integer >= 1, got {save_every!r}")
-    n = math.floor((t1 - t0) / h * (1 + 1e-12))
-    if n < 1:
-        raise _core.InvalidInputError(f"h = {h} s is longer than t_span ({t1 - t0} s): no step to take")
-    if n > _core.MAX_STEPS:
-        raise _core.InvalidInputError(
-            f"t_span / h asks for {n:.3e} steps; a run takes at most {_core.MAX_STEPS:.0e} steps "
-            "(split it into several runs, or take a longer h)")
-    if control_start is not None and not math.isfinite(float(control_start)):
-        raise _core.InvalidInputError(f"control_start must be finite (s) or None, got {control_start}")
-    if control_start is not None:
-        control_start = float(control_start)
+    if settings is None:
+        settings = Settings(t_span=t_span, h=h, method=method, control_start=control_start, outer=outer,
+                            save_every=save_every, linear_flow=linear_flow, ledger=ledger)
+    if isinstance(settings.save_every, float):
+        raise _core.InvalidInputError(f"save_every must be an integer >= 1, got {settings.save_every!r}")
     if initial is None:
-        y0 = vessel.initial_state()
+        y0 = None
     elif isinstance(initial, Mapping):
         y0 = vessel.initial_state(**initial)
     else:
-        y0 = np.ascontiguousarray(initial, dtype=float).reshape(-1)
-    if linear_flow not in ("exact", "gauss"):
-        raise _core.InvalidInputError(f"linear_flow must be 'exact' or 'gauss', got {linear_flow!r}")
-    raw = _core.integrate(vessel._inner, t0, h, n, method, control_start, outer, int(save_every), bool(ledger), y0,
-                          linear_flow, bool(orthonormalize))
+        try:
+            y0 = np.ascontiguousarray(initial, dtype=float)
+        except (TypeError, ValueError):
+            raise _core.InvalidInputError("initial must be a flat 27-vector of numbers or a mapping with euler, "
+                                          "position, velocity, angular_velocity") from None
+        if y0.ndim != 1:
+            raise _core.InvalidInputError(f"a flat initial state is a 1-D array of {_core.STATE_DIM} numbers, "
+                                          f"got shape {y0.shape}")
+    raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize))
+    used = raw["settings"]
     e = raw["energy"]
     dH = np.concatenate([[0.0], np.diff(e)])
-    info = _core.method_info(method)
-    if ledger and info["kind"] == "splitting" and not info["all_positive"] and len(e) > 1:
-        _warn_if_energy_created(raw, info, outer, e)
-    hull = vessel.to_dict()["vessel"]
+    info = _core.method_info(used["method"])
+    if used["ledger"] and info["kind"] == "splitting" and not info["all_positive"] and len(e) > 1:
+        _warn_if_energy_created(raw, info, used["outer"], e)
+    body = vessel.to_dict()["vessel"]
+    names = list(raw["accounts"])
     return Solution(
         t=raw["t"], x=raw["x"], euler=raw["euler"], quaternion=raw["quaternion"], Q=raw["Q"],
         p=raw["p"], m=raw["m"], mu=raw["mu"], phi_th=raw["phi_th"], phi_x=raw["phi_x"],
-        energy=e, ledger=Ledger(dH=dH, supplied=raw["supplied"], dissipated=raw["dissipated"]),
+        energy=e,
+        ledger=Ledger(dH=dH, supplied=raw["supplied"], dissipated=raw["dissipated"],
+                      by_account={n: raw["booked"][:, k] for k, n in enumerate(names)},
+                      kinds=dict(zip(names, raw["account_kinds"]))),
         orthogonality_defect=raw["orthogonality_defect"], status=raw["status"],
-        method=_core.method_info(method)["name"], h=h, control_start=control_start, steps=raw["steps"],
+        method=info["name"], h=used["h"], control_start=used["control_start"], steps=raw["steps"],
         failure=raw.get("failure"), last_good_state=raw["last_good"],
-        meta={"mass": hull["mass"], "inertia": hull["inertia"], "t_last_good": raw["t_last_good"]},
+        meta={"mass": body["mass"], "inertia": body["inertia"], "t_last_good": raw["t_last_good"],
+              "components": vessel.components},
+        account_force=raw["account_force"], account_moment=raw["account_moment"], settings=dict(used),
     )
