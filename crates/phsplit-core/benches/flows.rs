@@ -37,7 +37,7 @@ fn flows(c: &mut Criterion) {
         b.iter(|| sys.vector_field(black_box(&y0), true))
     });
     for (name, lf, order) in [
-        ("exact", LinearFlow::Exact, 2),
+        ("exact", LinearFlow::Exact, 2usize),
         ("gauss s=1", LinearFlow::Gauss, 2),
         ("gauss s=2", LinearFlow::Gauss, 4),
         ("gauss s=3", LinearFlow::Gauss, 6),
@@ -69,6 +69,7 @@ fn flows(c: &mut Criterion) {
                 t0: 0.0,
                 h: 0.05,
                 n_steps: 1000,
+                last_h: 0.05,
                 save_every: 1000,
                 outer: Outer::Dissipative,
                 ledger: false,

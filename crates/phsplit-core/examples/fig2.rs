@@ -14,6 +14,7 @@ fn main() {
         t0: 0.0,
         h,
         n_steps: (200.0 / h).round() as usize,
+        last_h: h,
         save_every: 1,
         outer: Outer::Dissipative,
         ledger: true,

@@ -19,6 +19,7 @@ fn main() {
         t0: 0.0,
         h: 0.1,
         n_steps: n,
+        last_h: 0.1,
         save_every: n,
         outer: Outer::Dissipative,
         ledger: false,

@@ -82,6 +82,24 @@ fn string<'a>(key: &str, v: &'a Value) -> Result<&'a str> {
     })
 }
 
+/// An output name: letters, digits, `.`, `_`, `-`, starting with a letter or digit, at most
+/// 100 characters, so that it names a file inside the output folder and nowhere else.
+pub fn check_name(name: &str) -> Result<String> {
+    let ok = !name.is_empty()
+        && name.len() <= 100
+        && name.chars().next().is_some_and(|c| c.is_ascii_alphanumeric())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-'));
+    if ok {
+        Ok(name.to_string())
+    } else {
+        Err(Error::InvalidInput(format!(
+            "simulation.name must be 1 to 100 letters, digits, '.', '_' or '-', starting with a letter or digit (it names the output files inside the output folder), got {name:?}"
+        )))
+    }
+}
+
 impl Settings {
     /// Settings from a `[simulation]` table over the defaults; unknown keys are refused with
     /// the nearest valid one. Returns the settings and the `name`, if given.
@@ -124,7 +142,7 @@ impl Settings {
                         Error::Parse(format!("simulation.ledger must be true or false, got {v}"))
                     })?
                 }
-                "name" => name = Some(string(key, v)?.to_string()),
+                "name" => name = Some(check_name(string(key, v)?)?),
                 other => {
                     return Err(Error::Parse(unknown(other, &valid, "field", "[simulation]")))
                 }
@@ -160,13 +178,35 @@ impl Settings {
                 "save_every must be an integer >= 1, got 0".into(),
             ));
         }
-        self.n_steps().map(|_| ())
+        let (n, last_h) = self.steps()?;
+        Options {
+            t0: self.t_span.0,
+            h: self.h,
+            n_steps: n,
+            last_h,
+            save_every: self.save_every,
+            outer: self.outer,
+            ledger: self.ledger,
+        }
+        .validate()
     }
 
-    /// The number of steps: `floor((t1 − t0)/h)` to round-off.
+    /// The number of steps: whole steps of `h`, and a last shorter one when the span is not a
+    /// whole number of steps (beyond round-off), so that the run ends at `t1`.
     pub fn n_steps(&self) -> Result<usize> {
+        Ok(self.steps()?.0)
+    }
+
+    /// The number of steps and the length of the last one.
+    pub fn steps(&self) -> Result<(usize, f64)> {
         let (t0, t1) = self.t_span;
-        let n = ((t1 - t0) / self.h * (1.0 + 1e-12)).floor();
+        let span = t1 - t0;
+        if !span.is_finite() {
+            return Err(Error::InvalidInput(format!(
+                "t_span must be finite with t1 > t0 (s), got ({t0}, {t1}), a span of {span} s"
+            )));
+        }
+        let n = (span / self.h * (1.0 + 1e-12)).floor();
         if n < 1.0 {
             return Err(Error::InvalidInput(format!(
                 "h = {} s is longer than t_span ({} s): no step to take",
@@ -179,20 +219,29 @@ impl Settings {
                 "t_span / h asks for {n:.3e} steps; a run takes at most {MAX_STEPS:.0e} steps (split it into several runs, or take a longer h)"
             )));
         }
-        Ok(n as usize)
+        let rest = span - n * self.h;
+        if rest > 1e-9 * self.h {
+            Ok((n as usize + 1, rest))
+        } else {
+            Ok((n as usize, self.h))
+        }
     }
 
     /// The kernels' options for this run.
     pub fn options(&self) -> Result<Options> {
         self.validate()?;
-        Ok(Options {
+        let (n_steps, last_h) = self.steps()?;
+        let o = Options {
             t0: self.t_span.0,
             h: self.h,
-            n_steps: self.n_steps()?,
+            n_steps,
+            last_h,
             save_every: self.save_every,
             outer: self.outer,
             ledger: self.ledger,
-        })
+        };
+        o.validate()?;
+        Ok(o)
     }
 }
 
@@ -212,6 +261,18 @@ mod tests {
         let (t, name) = Settings::from_table(&table("")).unwrap();
         assert_eq!(t, s);
         assert_eq!(name, None);
+    }
+
+    #[test]
+    fn a_span_that_is_not_whole_steps_ends_with_a_shorter_one() {
+        let mut s = Settings { t_span: (0.0, 1.0), h: 0.3, ..Settings::default() };
+        let o = s.options().unwrap();
+        assert_eq!((o.n_steps, o.h), (4, 0.3));
+        assert!((o.last_h - 0.1).abs() < 1e-15);
+        assert!((o.time_after(3) - 1.0).abs() < 1e-15);
+        s.t_span = (0.0, 0.9 + 1e-14); // round-off: three whole steps
+        assert_eq!(s.options().unwrap().n_steps, 3);
+        assert_eq!(s.options().unwrap().last_h, 0.3);
     }
 
     #[test]
@@ -235,6 +296,12 @@ mod tests {
             ("outer = \"S1\"", "dissipative"),
             ("linear_flow = \"pade\"", "gauss"),
             ("ledger = 1", "true or false"),
+            ("name = \"../../escape\"", "simulation.name must be"),
+            ("name = \"\"", "simulation.name must be"),
+            ("name = \"a/b\"", "simulation.name must be"),
+            ("t_span = [1e17, 1.00000000000000010e17]\nh = 1", "resolve"),
+            ("t_span = [0, 1e308]\nh = 1e-300", "at most"),
+            ("t_span = [-1e308, 1e308]", "finite"),
         ] {
             let e = Settings::from_table(&table(text)).unwrap_err().to_string();
             assert!(e.contains(needle), "{text}: {e}");

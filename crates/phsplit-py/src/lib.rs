@@ -5,6 +5,7 @@
 //! and parameter is parsed and validated by the core. Nothing here panics across the
 //! boundary: every fallible call returns `PyResult`, and a panic in the core is caught.
 
+
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use phsplit_core::lie::so3;
@@ -13,7 +14,7 @@ use phsplit_core::model::vessel::{
     LinearFlow, Vessel, VesselState, VesselSystem, PAPER_VESSEL_TOML, STATE_DIM,
 };
 use phsplit_core::settings::{Settings, KEYS};
-use phsplit_core::solve::{run, AccountKind, Status};
+use phsplit_core::solve::{run_watched, AccountKind, Monitor, Status};
 use phsplit_core::Error;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
@@ -269,7 +270,9 @@ fn settings_dict<'py>(py: Python<'py>, s: &Settings, name: Option<String>) -> Py
     d.set_item("save_every", s.save_every)?;
     d.set_item("linear_flow", s.linear_flow.name())?;
     d.set_item("ledger", s.ledger)?;
-    d.set_item("n_steps", s.n_steps().ok())?;
+    let steps = s.steps().ok();
+    d.set_item("n_steps", steps.map(|x| x.0))?;
+    d.set_item("last_h", steps.map(|x| x.1))?;
     if let Some(n) = name {
         d.set_item("name", n)?;
     }
@@ -317,17 +320,53 @@ fn method_info<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>>
     Ok(d)
 }
 
+/// Watches a run from Python: about every 0.1 s it takes the GIL, runs Python's signal
+/// handlers (Ctrl-C, or SIGTERM where the program turned it into KeyboardInterrupt) and calls
+/// the progress callback `f(steps_done, n_steps)`. An exception stops the run; it is kept to be
+/// raised (or, for KeyboardInterrupt, reported as an interrupted run) once the GIL is back.
+struct PyMonitor {
+    progress: Option<Py<PyAny>>,
+    n_steps: usize,
+    last: std::time::Instant,
+    error: Option<PyErr>,
+}
+
+impl Monitor for PyMonitor {
+    fn keep_going(&mut self, done: usize) -> bool {
+        if done % 256 != 0 || self.last.elapsed().as_secs_f64() < 0.1 {
+            return true;
+        }
+        self.last = std::time::Instant::now();
+        let r = Python::attach(|py| -> PyResult<()> {
+            py.check_signals()?;
+            if let Some(cb) = &self.progress {
+                cb.call1(py, (done, self.n_steps))?;
+            }
+            Ok(())
+        });
+        match r {
+            Ok(()) => true,
+            Err(e) => {
+                self.error = Some(e);
+                false
+            }
+        }
+    }
+}
+
 /// Integrate with the given settings (a mapping over the defaults) from `state0` (a flat
 /// 27-vector; None: the vessel's initial state); returns a dict of numpy arrays. The GIL is
-/// released while integrating.
+/// released while integrating; signals are checked about every 0.1 s, and Ctrl-C returns what
+/// was computed with status "interrupted". `progress(steps_done, n_steps)` is called as often.
 #[pyfunction]
-#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false))]
+#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None))]
 fn integrate<'py>(
     py: Python<'py>,
     vessel: &PyVessel,
     settings: &Bound<'py, PyDict>,
     state0: Option<PyReadonlyArray1<'_, f64>>,
     orthonormalize: bool,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (settings, _) = settings_of(settings, true)?;
     let opts = settings.options().map_err(to_py)?;
@@ -337,12 +376,19 @@ fn integrate<'py>(
     };
     let v = vessel.inner.clone();
     let s2 = settings.clone();
+    let mut monitor = PyMonitor {
+        progress,
+        n_steps: opts.n_steps,
+        last: std::time::Instant::now(),
+        error: None,
+    };
+    let mon = &mut monitor;
     // A panic in the core (a bug) reaches Python as a PhsplitError, never an abort.
     let out = py
         .detach(move || {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 let sys = VesselSystem::new(&v, s2.control_start).with_linear_flow(s2.linear_flow);
-                let traj = run(&sys, &s2.method, y0, &opts)?;
+                let traj = run_watched(&sys, &s2.method, y0, &opts, mon)?;
                 // The force and moment of each account at the saved states.
                 let wrenches: Vec<_> = traj
                     .t
@@ -363,6 +409,11 @@ fn integrate<'py>(
         })?
         .map_err(to_py)?;
     let (traj, wrenches) = out;
+    if let Some(e) = monitor.error.take() {
+        if !e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
+            return Err(e); // an exception of the progress callback, or of a signal handler
+        }
+    }
     let n = traj.t.len();
     let k = traj.accounts.len();
     let mut cols: [Vec<f64>; 8] = Default::default();
@@ -421,6 +472,10 @@ fn integrate<'py>(
         Status::Failed { step, t, reason } => {
             d.set_item("status", "failed")?;
             d.set_item("failure", format!("step {step} (t = {t}): {reason}"))?;
+        }
+        Status::Interrupted { step, t } => {
+            d.set_item("status", "interrupted")?;
+            d.set_item("failure", format!("interrupted after step {step} (t = {t})"))?;
         }
     }
     Ok(d)

@@ -22,6 +22,7 @@ import datetime as _dt
 import math
 import os
 import platform
+import re
 import shutil
 import tempfile
 import time
@@ -65,10 +66,18 @@ class Settings:
 
 @dataclass
 class Claim:
+    """One of the paper's claims with what was measured. ``holds`` only when the measurement
+    supports exactly the claim; ``partly`` says why when it supports only a part of it."""
+
     claim: str
     where: str
     measured: str
     holds: bool
+    partly: str = ""
+
+    @property
+    def verdict(self) -> str:
+        return "yes" if self.holds else (f"partly: {self.partly}" if self.partly else "no")
 
 
 @dataclass
@@ -194,6 +203,7 @@ def run_fig2(vessel: Vessel, s: Settings, res: Results, bar) -> None:
 
 def run_fig4(vessel: Vessel, s: Settings, res: Results, bar) -> None:
     for split, rk, h, t_end in (("sp2", "heun", 2.0 / 3.0, 50.0), ("sp4", "rk4", 1.9375, 100.0)):
+        t_end = math.floor(t_end / h * (1 + 1e-12)) * h  # whole steps: the comparison grid is uniform
         a = simulate(vessel, (0.0, t_end), h, split, control_start=0.0)
         b = simulate(vessel, (0.0, t_end), h, rk, control_start=0.0)
         n_sub = 8 * max(1, round(h / s.h_ref / 8))  # reference steps per method step, multiple of 8
@@ -426,11 +436,21 @@ def evaluate_claims(res: Results, vessel: Vessel) -> None:
     ref_x = vessel.to_dict()["control"]["position_reference"]
     ref_yaw = vessel.to_dict()["control"]["euler_reference"][2]
     overshoot_x = float(s.x[:, 0].max() - ref_x[0])
+    dist = np.hypot(s.x[:, 0] - ref_x[0], s.x[:, 1] - ref_x[1])
+    d_end, d_150 = float(dist[-1]), float(dist[np.searchsorted(s.t, 150.0)])
+    at_set = d_end <= 0.1 and abs(s.euler[-1, 2] - ref_yaw) <= 0.01
+    # After the overshoot the integral action pulls the vessel back slowly: "converging" means the
+    # distance falls monotonically over [150, 200] s with yaw at its set point, not that it has arrived.
+    tail = dist[s.t >= 150.0]
+    converging = (d_end < d_150 and bool(np.all(np.diff(tail) <= 1e-9))
+                  and abs(s.euler[-1, 2] - ref_yaw) <= 0.01 and overshoot_x > 0)
     c.append(Claim("x, y and yaw converge to the set point (780, 20, 0.54) with a slight overshoot", "§4, Fig. 2",
                    f"at t = 200: x = {s.x[-1, 0]:.2f} m, y = {s.x[-1, 1]:.2f} m, yaw = {s.euler[-1, 2]:.4f} rad; "
                    f"overshoot of x {overshoot_x:.2f} m, of yaw {s.euler[:, 2].max() - ref_yaw:.3f} rad",
-                   abs(s.x[-1, 0] - ref_x[0]) <= 1.5 and abs(s.x[-1, 1] - ref_x[1]) <= 0.5
-                   and abs(s.euler[-1, 2] - ref_yaw) <= 0.01 and overshoot_x > 0))
+                   at_set and overshoot_x > 0,
+                   "" if not converging else f"still {d_end:.2f} m from the set point at t = 200 s (the end of the "
+                   f"paper's figure), down from {d_150:.2f} m at t = 150 s and falling monotonically: the overshoot "
+                   f"decays slowly under the integral action; converging, not yet there"))
     amp = [(np.abs(s.euler[s.t <= 50, i]).max(), np.abs(s.euler[s.t >= 150, i]).max()) for i in (0, 1)]
     c.append(Claim("roll and pitch oscillate and are damped", "§4, Fig. 2",
                    f"max |roll| {amp[0][0]:.4f} → {amp[0][1]:.4f} rad, max |pitch| {amp[1][0]:.4f} → {amp[1][1]:.5f} rad "
@@ -452,10 +472,15 @@ def evaluate_claims(res: Results, vessel: Vessel) -> None:
     c.append(Claim("explicit Runge–Kutta methods become unstable for larger h", "§4",
                    ", ".join(f"{m}: diverges from h = {v:g} s" if v else f"{m}: stable up to {hmax:g} s"
                              for m, v in rk_div.items()), all(v is not None for v in rk_div.values())))
+    positive_ok = all(sp_div[m] is None for m in ("lie", "sp2"))
+    diverging = [m for m, v in sp_div.items() if v is not None]
     c.append(Claim("splitting methods do not become unstable; the error stays bounded", "§4",
                    ", ".join(f"{m}: " + (f"diverges from h = {v:g} s" if v else f"bounded up to h = {hmax:g} s")
                              for m, v in sp_div.items()),
-                   all(sp_div[m] is None for m in ("lie", "sp2"))))
+                   positive_ok and not diverging,
+                   "" if not (positive_ok and diverging) else
+                   f"{', '.join(m.upper() for m in diverging)} diverge(s) at long steps; only the positive-step "
+                   "methods (Lie, SP2) are passive for every h (Prop. 2.2), and those stay bounded"))
     ortho = max(float(res.fig2.orthogonality_defect.max()),
                 max(float(res.fig4[k]["split"].orthogonality_defect.max()) for k in res.fig4))
     c.append(Claim("the numerical attitude evolves on SO(3)", "§3.4.1, §5",
@@ -496,12 +521,18 @@ def render_report(res: Results, vessel: Vessel) -> str:
              f"`phsplit reproduce{' --quick' if s.quick else ''}`.")
     L.append("")
     n_ok = sum(c.holds for c in res.claims)
-    L.append(f"## Claims: {n_ok} of {len(res.claims)} hold")
+    n_part = sum(bool(c.partly) and not c.holds for c in res.claims)
+    L.append(f"## Claims: {n_ok} of {len(res.claims)} hold" + (f", {n_part} partly" if n_part else ""))
     L.append("")
     L.append("| claim | paper | measured | holds |")
     L.append("|---|---|---|---|")
+
+    def cell(t: str) -> str:
+        return t.replace("|", "\\|")
+
     for c in res.claims:
-        L.append(f"| {c.claim} | {c.where} | {c.measured} | {'yes' if c.holds else '**no**'} |")
+        v = c.verdict if c.holds or c.partly else "**no**"
+        L.append(f"| {cell(c.claim)} | {cell(c.where)} | {cell(c.measured)} | {cell(v)} |")
     L.append("")
     L.append("## Fig. 2: the controlled vessel")
     L.append("")
@@ -612,7 +643,8 @@ def _html(md: str, stage: str) -> str:
         elif line.startswith("|"):
             rows = []
             while i < len(lines) and lines[i].startswith("|"):
-                rows.append([c.strip() for c in lines[i].strip("|").split("|")])
+                cells = re.split(r"(?<!\\)\|", lines[i].strip()[1:-1])  # unescaped pipes
+                rows.append([c.strip().replace("\\|", "|") for c in cells])
                 i += 1
             out.append("<table><tr>" + "".join(f"<th>{inline(c)}</th>" for c in rows[0]) + "</tr>")
             for r in rows[2:]:
@@ -688,7 +720,7 @@ def reproduce(out: str, quick: bool = False, progress: bool = True, vessel: Vess
 
 def summary_table(res: Results) -> str:
     rows = [("claim", "measured", "holds")]
-    rows += [(c.claim, c.measured, "yes" if c.holds else "NO") for c in res.claims]
+    rows += [(c.claim, c.measured, "yes" if c.holds else ("partly" if c.partly else "NO")) for c in res.claims]
     w0 = min(max(len(r[0]) for r in rows), 60)
     w1 = min(max(len(r[1]) for r in rows), 70)
 

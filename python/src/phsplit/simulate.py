@@ -104,7 +104,10 @@ class Vessel:
 
 
 def _vec3(name: str, v: Any) -> list[float]:
-    a = np.asarray(v, dtype=float)
+    try:
+        a = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError(f"{name} must be 3 numbers, got {v!r}") from None
     if a.shape != (3,):
         raise _core.InvalidInputError(f"{name} must have 3 components, got shape {a.shape}")
     return [float(x) for x in a]
@@ -340,6 +343,7 @@ def simulate(
     linear_flow: str = Settings.linear_flow,
     orthonormalize: bool = False,
     settings: Settings | None = None,
+    progress: bool | Any = None,
 ) -> Solution:
     """Simulate the vessel with fixed steps ``h`` over ``t_span``.
 
@@ -358,8 +362,15 @@ def simulate(
     settings arguments at once.
 
     Every setting is validated by the core; a bad one raises ``InvalidInputError`` naming it.
+    A span that is not a whole number of steps ends with one shorter step, at ``t1``.
     A run whose state becomes non-finite stops there: ``status == "failed"``, ``failure`` says
     where, the arrays hold what was saved before, ``last_good_state`` the last finite state.
+
+    Long runs: the core checks for Ctrl-C about every 0.1 s; an interrupted run returns what it
+    computed, ending on its last completed step, with ``status == "interrupted"``.
+    ``progress=True`` shows a progress bar (tqdm); a callable is called as
+    ``progress(steps_done, n_steps)`` as often (an exception it raises stops the run and is
+    raised).
     """
     if not isinstance(vessel, Vessel):
         raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
@@ -381,7 +392,26 @@ def simulate(
         if y0.ndim != 1:
             raise _core.InvalidInputError(f"a flat initial state is a 1-D array of {_core.STATE_DIM} numbers, "
                                           f"got shape {y0.shape}")
-    raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize))
+    if progress is True:
+        from tqdm import tqdm
+
+        n = settings.checked()["n_steps"]
+        bar = tqdm(total=n, unit="step", unit_scale=True, leave=False)
+
+        def cb(done, total, _bar=bar):
+            _bar.update(done - _bar.n)
+    elif progress is None or progress is False:
+        bar, cb = None, None
+    elif callable(progress):
+        bar, cb = None, progress
+    else:
+        raise _core.InvalidInputError(f"progress must be True, False, None or a callable f(steps_done, n_steps), "
+                                      f"got {type(progress).__name__}")
+    try:
+        raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), cb)
+    finally:
+        if bar is not None:
+            bar.close()
     used = raw["settings"]
     e = raw["energy"]
     dH = np.concatenate([[0.0], np.diff(e)])

@@ -10,7 +10,7 @@
 
 use super::options::Options;
 use super::system::{FieldModel, Flow, SplitModel, Work};
-use super::trajectory::{saves_after, Recorder, Trajectory};
+use super::trajectory::{saves_after, Monitor, Recorder, Trajectory, Unwatched};
 use crate::error::Result;
 use crate::methods::{ButcherTableau, Composition, Method};
 use nalgebra::SVector;
@@ -25,6 +25,17 @@ pub fn run_splitting<M: SplitModel>(
     method: &Composition,
     y0: M::State,
     opts: &Options,
+) -> Result<Trajectory<M::State>> {
+    run_splitting_watched(model, method, y0, opts, &mut Unwatched)
+}
+
+/// [`run_splitting`] under a [`Monitor`], asked after every step whether to go on.
+pub fn run_splitting_watched<M: SplitModel>(
+    model: &M,
+    method: &Composition,
+    y0: M::State,
+    opts: &Options,
+    monitor: &mut dyn Monitor,
 ) -> Result<Trajectory<M::State>> {
     opts.validate()?;
     model.supports_order(method.order)?;
@@ -42,8 +53,9 @@ pub fn run_splitting<M: SplitModel>(
     let mut pending: Option<(Flow, f64, f64)> = None;
     for n in 0..opts.n_steps {
         let t = opts.t0 + n as f64 * opts.h;
+        let (hn, t1) = (opts.step_length(n), opts.time_after(n));
         for (i, &(flow, c)) in subs.iter().enumerate() {
-            let mut len = c * opts.h;
+            let mut len = c * hn;
             if i == 0 {
                 if let Some((pf, plen, pt)) = pending.take() {
                     if pf == flow && model.same_field(pt, t) {
@@ -53,7 +65,7 @@ pub fn run_splitting<M: SplitModel>(
                     }
                 }
             }
-            if i == last && fsal && !saves_after(n, opts) && model.same_field(t, t + opts.h) {
+            if i == last && fsal && !saves_after(n, opts) && model.same_field(t, t1) {
                 pending = Some((flow, len, t));
                 continue;
             }
@@ -66,10 +78,21 @@ pub fn run_splitting<M: SplitModel>(
         if pending.is_none() {
             // y sits on the step boundary (no sub-step deferred into the next step).
             rec.traj.last_good = y;
-            rec.traj.t_last_good = t + opts.h;
+            rec.traj.t_last_good = t1;
         }
-        if saves_after(n, opts) {
-            rec.save(t + opts.h, y);
+        let saved = saves_after(n, opts);
+        if saved {
+            rec.save(t1, y);
+        }
+        if n + 1 < opts.n_steps && !monitor.keep_going(n + 1) {
+            // Complete the step (a deferred sub-step), then stop on its boundary.
+            if let Some((pf, plen, pt)) = pending.take() {
+                rec.acc += model.flow(pf, plen, pt, method.order, opts.ledger, &mut y);
+                if !model.is_finite(&y) {
+                    return Ok(rec.fail(n, t));
+                }
+            }
+            return Ok(rec.interrupt(n + 1, t1, y, saved));
         }
     }
     Ok(rec.traj)
@@ -82,14 +105,25 @@ pub fn run_runge_kutta<const N: usize, M: FieldModel<N>>(
     y0: M::State,
     opts: &Options,
 ) -> Result<Trajectory<M::State>> {
+    run_runge_kutta_watched(model, tableau, y0, opts, &mut Unwatched)
+}
+
+/// [`run_runge_kutta`] under a [`Monitor`], asked after every step whether to go on.
+pub fn run_runge_kutta_watched<const N: usize, M: FieldModel<N>>(
+    model: &M,
+    tableau: &ButcherTableau,
+    y0: M::State,
+    opts: &Options,
+    monitor: &mut dyn Monitor,
+) -> Result<Trajectory<M::State>> {
     opts.validate()?;
     let s = tableau.stages();
     let mut rec = Recorder::new(model, opts.t0, y0, opts);
     let mut y = model.to_vector(&y0);
     let mut k: Vec<SVector<f64, N>> = vec![SVector::zeros(); s];
-    let h = opts.h;
     for n in 0..opts.n_steps {
-        let t = opts.t0 + n as f64 * h;
+        let t = opts.t0 + n as f64 * opts.h;
+        let (h, t1) = (opts.step_length(n), opts.time_after(n));
         let mut work = Work::default();
         for i in 0..s {
             let mut yi = y;
@@ -117,12 +151,16 @@ pub fn run_runge_kutta<const N: usize, M: FieldModel<N>>(
         y = y1;
         rec.acc += work;
         rec.traj.steps = n + 1;
-        if saves_after(n, opts) {
-            rec.save(t + h, model.from_vector(&y));
+        let saved = saves_after(n, opts);
+        if saved {
+            rec.save(t1, model.from_vector(&y));
+        }
+        if n + 1 < opts.n_steps && !monitor.keep_going(n + 1) {
+            return Ok(rec.interrupt(n + 1, t1, model.from_vector(&y), saved));
         }
     }
     rec.traj.last_good = model.from_vector(&y);
-    rec.traj.t_last_good = opts.t0 + opts.n_steps as f64 * h;
+    rec.traj.t_last_good = opts.time_after(opts.n_steps - 1);
     Ok(rec.traj)
 }
 
@@ -133,9 +171,20 @@ pub fn run<const N: usize, M: SplitModel + FieldModel<N>>(
     y0: M::State,
     opts: &Options,
 ) -> Result<Trajectory<M::State>> {
+    run_watched(model, method, y0, opts, &mut Unwatched)
+}
+
+/// [`run`] under a [`Monitor`].
+pub fn run_watched<const N: usize, M: SplitModel + FieldModel<N>>(
+    model: &M,
+    method: &Method,
+    y0: M::State,
+    opts: &Options,
+    monitor: &mut dyn Monitor,
+) -> Result<Trajectory<M::State>> {
     match method {
-        Method::Splitting(c) => run_splitting(model, c, y0, opts),
-        Method::RungeKutta(t) => run_runge_kutta(model, t, y0, opts),
+        Method::Splitting(c) => run_splitting_watched(model, c, y0, opts, monitor),
+        Method::RungeKutta(t) => run_runge_kutta_watched(model, t, y0, opts, monitor),
     }
 }
 
@@ -244,7 +293,7 @@ mod tests {
     }
 
     fn opts(h: f64, n: usize, save_every: usize, outer: Outer) -> Options {
-        Options { t0: 0.0, h, n_steps: n, save_every, outer, ledger: true }
+        Options { outer, ..Options::steps(0.0, h, n, save_every) }
     }
 
     #[test]
@@ -339,5 +388,52 @@ mod tests {
         // Bad options are refused before the first step.
         let e = run(&Osc { growth: None }, &"sp2".parse().unwrap(), [0.0; 2], &opts(0.0, 1, 1, Outer::Dissipative));
         assert!(e.unwrap_err().to_string().contains("h must be"));
+    }
+
+    /// Stops the run after a given number of steps.
+    struct StopAfter(usize);
+    impl crate::solve::Monitor for StopAfter {
+        fn keep_going(&mut self, done: usize) -> bool {
+            done < self.0
+        }
+    }
+
+    #[test]
+    fn an_interrupted_run_ends_on_a_completed_step() {
+        for name in ["sp2", "sp4", "rk4"] {
+            let m: Method = name.parse().unwrap();
+            // save_every 5: the composition defers (merges) its last sub-step across unsaved
+            // boundaries; the interrupt must complete the step first.
+            let o = opts(0.1, 50, 5, Outer::Dissipative);
+            let tr = run_watched(&Osc { growth: None }, &m, [1.0, 0.2], &o, &mut StopAfter(7)).unwrap();
+            assert_eq!(tr.status, Status::Interrupted { step: 7, t: 0.7000000000000001 }, "{name}");
+            assert_eq!(tr.steps, 7);
+            let t: Vec<f64> = tr.t.iter().map(|t| (t * 10.0).round()).collect();
+            assert_eq!(t, [0.0, 5.0, 7.0], "{name}");
+            let full = run(&Osc { growth: None }, &m, [1.0, 0.2], &opts(0.1, 7, 1, Outer::Dissipative)).unwrap();
+            let (a, b) = (tr.states.last().unwrap(), full.states.last().unwrap());
+            assert!((a[0] - b[0]).abs() < 1e-14 && (a[1] - b[1]).abs() < 1e-14, "{name}: {a:?} vs {b:?}");
+            assert_eq!(tr.last_good, *a);
+            // the ledger of the interrupted run closes as the completed one's
+            let sa: f64 = tr.supplied.iter().sum();
+            let sb: f64 = full.supplied.iter().sum();
+            assert!((sa - sb).abs() < 1e-14, "{name}: {sa} vs {sb}");
+        }
+    }
+
+    #[test]
+    fn a_span_that_is_not_whole_steps_is_reached_exactly() {
+        // [0, 1] with h = 0.3: three steps of 0.3 and one of 0.1.
+        let ex = exact(1.0, [1.0, -0.5]);
+        for name in ["sp2", "sp4", "rk4", "lie"] {
+            let m: Method = name.parse().unwrap();
+            let o = Options { last_h: 0.1, ..opts(0.3, 4, 1, Outer::Dissipative) };
+            let tr = run(&Osc { growth: None }, &m, [1.0, -0.5], &o).unwrap();
+            assert!((tr.t.last().unwrap() - 1.0).abs() < 1e-15, "{name}: {:?}", tr.t);
+            let y = tr.states.last().unwrap();
+            let err = ((y[0] - ex[0]).powi(2) + (y[1] - ex[1]).powi(2)).sqrt();
+            // the local errors of a method of order p at h = 0.3: far below 0.3^p... but not 0
+            assert!(err < 0.3f64.powi(m.order() as i32) && err > 0.0, "{name}: {err}");
+        }
     }
 }

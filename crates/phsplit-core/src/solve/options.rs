@@ -12,6 +12,9 @@ pub struct Options {
     pub h: f64,
     /// Number of steps.
     pub n_steps: usize,
+    /// Length of the last step (`0 < last_h ≤ h`; `h` when the span is a whole number of steps):
+    /// a run reaches its end time exactly.
+    pub last_h: f64,
     /// Save every k-th step (the last step is always saved).
     pub save_every: usize,
     /// Which flow is outermost in a composition.
@@ -24,6 +27,38 @@ pub struct Options {
 pub const MAX_STEPS: usize = 2_000_000_000;
 
 impl Options {
+    /// Options for `n_steps` steps of `h` from `t0` (the last one whole), saving every
+    /// `save_every`-th step, S2 outermost, with the ledger.
+    pub fn steps(t0: f64, h: f64, n_steps: usize, save_every: usize) -> Self {
+        Self {
+            t0,
+            h,
+            n_steps,
+            last_h: h,
+            save_every,
+            outer: Outer::Dissipative,
+            ledger: true,
+        }
+    }
+
+    /// The length of step `n` (0-based).
+    pub fn step_length(&self, n: usize) -> f64 {
+        if n + 1 == self.n_steps {
+            self.last_h
+        } else {
+            self.h
+        }
+    }
+
+    /// The time at the end of step `n`.
+    pub fn time_after(&self, n: usize) -> f64 {
+        if n + 1 == self.n_steps && self.last_h != self.h {
+            self.t0 + n as f64 * self.h + self.last_h
+        } else {
+            self.t0 + (n + 1) as f64 * self.h
+        }
+    }
+
     /// Check the options; the message names the field and the allowed range.
     pub fn validate(&self) -> Result<()> {
         if !self.t0.is_finite() {
@@ -42,6 +77,21 @@ impl Options {
             return Err(Error::InvalidInput(format!(
                 "the number of steps must be between 1 and {MAX_STEPS}, got {}",
                 self.n_steps
+            )));
+        }
+        if !(self.last_h > 0.0 && self.last_h <= self.h) {
+            return Err(Error::InvalidInput(format!(
+                "the last step must be in (0, h] (s), got {} with h = {}",
+                self.last_h, self.h
+            )));
+        }
+        // Every step must advance the time: h above the resolution of t over the run.
+        let t_max = self.t0.abs().max((self.t0 + self.n_steps as f64 * self.h).abs());
+        let ulp = t_max * f64::EPSILON;
+        if self.last_h <= 4.0 * ulp || self.h <= 64.0 * ulp {
+            return Err(Error::InvalidInput(format!(
+                "h = {} s is below what the times of this run can resolve (|t| up to {t_max:e} s, where doubles are {ulp:.3e} s apart): shift t_span towards 0 or take a longer h",
+                if self.last_h < self.h { self.last_h } else { self.h }
             )));
         }
         if self.save_every == 0 {

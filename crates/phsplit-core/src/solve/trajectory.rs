@@ -14,6 +14,25 @@ pub enum Status {
         t: f64,
         reason: String,
     },
+    /// Stopped at the request of the caller (an interrupt) after `step` steps, at `t`; the
+    /// trajectory ends with the state there.
+    Interrupted { step: usize, t: f64 },
+}
+
+/// Watches a run: called after every step with the number of steps done; returning `false`
+/// stops the run there (status [`Status::Interrupted`]). Also the place for progress reports.
+pub trait Monitor {
+    fn keep_going(&mut self, steps_done: usize) -> bool;
+}
+
+/// A monitor that never stops a run.
+pub struct Unwatched;
+
+impl Monitor for Unwatched {
+    #[inline]
+    fn keep_going(&mut self, _: usize) -> bool {
+        true
+    }
 }
 
 /// Saved states and the ledger of a run.
@@ -100,6 +119,18 @@ impl<'m, M: Model> Recorder<'m, M> {
             t,
             reason: "the state became non-finite".into(),
         };
+        self.traj
+    }
+    /// End the run at the caller's request after `steps` steps, at `t` with the state `y` (saved
+    /// if it was not).
+    pub(crate) fn interrupt(mut self, steps: usize, t: f64, y: M::State, saved: bool) -> Trajectory<M::State> {
+        if !saved {
+            self.save(t, y);
+        }
+        self.traj.steps = steps;
+        self.traj.last_good = y;
+        self.traj.t_last_good = t;
+        self.traj.status = Status::Interrupted { step: steps, t };
         self.traj
     }
     pub(crate) fn save(&mut self, t: f64, y: M::State) {
