@@ -8,7 +8,7 @@ BIN    := $(VENV)/bin
 OUT    ?= out
 RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
 
-.PHONY: run test test-rust test-python build reproduce bench bench-quick fuzz elliptic-refs clean
+.PHONY: run test test-rust test-python build reproduce bench bench-quick fuzz elliptic-refs rigid-body-refs clean
 
 run: $(VENV)/.built
 	$(BIN)/phsplit simulate --out $(OUT)
@@ -62,6 +62,10 @@ fuzz: $(VENV)/.built
 # Regenerate the mpmath reference table of the elliptic functions (checked in).
 elliptic-refs: $(VENV)/.deps
 	$(BIN)/python scripts/gen_elliptic_refs.py
+
+# The mpmath table for the free rigid body (minutes; the table is committed).
+rigid-body-refs: $(VENV)/.deps
+	$(BIN)/python scripts/gen_rigid_body_refs.py
 
 clean:
 	rm -rf $(VENV) target $(OUT)

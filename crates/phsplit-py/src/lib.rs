@@ -5,6 +5,7 @@
 //! and parameter is parsed and validated by the core. Nothing here panics across the
 //! boundary: every fallible call returns `PyResult`, and a panic in the core is caught.
 
+mod numerics;
 
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
@@ -563,6 +564,7 @@ fn vessel_tables() -> Vec<&'static str> {
 
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    numerics::register(m)?;
     m.add_class::<PyVessel>()?;
     m.add_class::<PyVectorField>()?;
     m.add_function(wrap_pyfunction!(integrate, m)?)?;

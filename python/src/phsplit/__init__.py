@@ -19,6 +19,7 @@ from ._core import (
     __version__,
 )
 from ._core import method_info as _method_info
+from . import rigid_body, so3, special
 from .batch import simulate_many, with_parameters
 from .scenario import Scenario
 from .scenario import load as load_scenario
@@ -45,7 +46,10 @@ __all__ = [
     "__version__",
     "load_scenario",
     "method_info",
+    "rigid_body",
     "simulate",
     "simulate_many",
+    "so3",
+    "special",
     "with_parameters",
 ]

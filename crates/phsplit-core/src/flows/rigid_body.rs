@@ -28,7 +28,7 @@
 //! §3.4.1 with the signs of docs/model.md §3: for `Q' = Q A(t)` every even-degree commutator term
 //! changes sign relative to the printed `Y' = A(t) Y` formulas).
 
-use crate::lie::elliptic::{ellipf, jacobi};
+use crate::lie::elliptic::{ellipf_scd, ellipk_m1, jacobi_m1};
 use crate::error::{Error, Result};
 use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
@@ -66,6 +66,10 @@ impl MagnusOrder {
 pub struct FreeRigidBody {
     inertia: Vector3<f64>,
     inv: Vector3<f64>,
+    /// `|J_lo − J_mid|, |J_lo − J_hi|, |J_mid − J_hi|` (`J = T⁻¹`, axes ordered by inertia), as
+    /// `|T_j − T_i| / (T_i T_j)`: to round-off relative to the difference itself, however close
+    /// the inertias (`1/T_i − 1/T_j` would cancel for a near-symmetric body).
+    gap: [f64; 3],
     /// Axis indices ordered by inertia: lo, mid, hi.
     order: [usize; 3],
 }
@@ -83,9 +87,12 @@ impl FreeRigidBody {
         }
         let mut order = [0usize, 1, 2];
         order.sort_by(|&i, &j| inertia[i].total_cmp(&inertia[j]));
+        let gap = |i: usize, j: usize| (inertia[j] - inertia[i]).abs() / inertia[i] / inertia[j];
+        let [lo, mid, hi] = order;
         Ok(Self {
             inertia,
             inv: inertia.map(|v| 1.0 / v),
+            gap: [gap(lo, mid), gap(lo, hi), gap(mid, hi)],
             order,
         })
     }
@@ -107,40 +114,51 @@ impl FreeRigidBody {
 
     /// The exact momentum orbit through `m0`: evaluate it at any time with [`Orbit::momentum`].
     pub fn orbit(&self, m0: &Vector3<f64>) -> Orbit {
-        let j = &self.inv;
         let [lo, mid, hi] = self.order;
         let fixed = Orbit {
             m0: *m0,
             data: None,
         };
-        if m0.iter().all(|v| *v == 0.0) || j[lo] == j[hi] {
+        if m0.iter().all(|v| *v == 0.0) || self.inertia[lo] == self.inertia[hi] {
             return fixed; // zero momentum, or a sphere: w ∥ m
         }
         let sq = |i: usize| m0[i] * m0[i];
-        let d = |x: f64, y: f64| (x - y).abs();
+        let [d_lm, d_lh, d_mh] = self.gap;
         // Case (c, d) = (lo, hi).
-        let a_lh = sq(lo) * d(j[lo], j[hi]) + sq(mid) * d(j[mid], j[hi]);
-        let b_lh = sq(mid) * d(j[lo], j[mid]) + sq(hi) * d(j[lo], j[hi]);
-        let num = a_lh * d(j[lo], j[mid]);
-        let den = b_lh * d(j[mid], j[hi]);
-        let (c, dd, a, b, k2) = if num <= den {
-            (lo, hi, a_lh, b_lh, if den > 0.0 { num / den } else { 0.0 })
+        let a_lh = sq(lo) * d_lh + sq(mid) * d_mh;
+        let b_lh = sq(mid) * d_lm + sq(hi) * d_lh;
+        let num = a_lh * d_lm;
+        let den = b_lh * d_mh;
+        // den − num = |J_lo − J_hi| g, with the m_mid² terms cancelled in exact arithmetic:
+        // g = 0 is the separatrix, and its sign picks the case. 1 − k² is formed from g, not as
+        // 1 − num/den, which next to the separatrix (k² → 1) would keep only the digits of
+        // 1 − k² that survive the cancellation (issue 16: two of them at k² = 1 − 1.3e-14).
+        let g = sq(hi) * d_mh - sq(lo) * d_lm;
+        // (c, d, a, b, k², k'², |J_c − J_d|, |J_mid − J_d|)
+        let (c, dd, a, b, k2, k1, d_cd, d_md) = if g >= 0.0 {
+            let (k2, k1) = if den > 0.0 {
+                (num / den, d_lh * g / den)
+            } else {
+                (0.0, 1.0)
+            };
+            (lo, hi, a_lh, b_lh, k2, k1, d_lh, d_mh)
         } else {
-            (hi, lo, b_lh, a_lh, den / num)
+            (hi, lo, b_lh, a_lh, den / num, d_lh * -g / num, d_lh, d_lm)
         };
         if a == 0.0 || b == 0.0 || (m0[c] == 0.0 && m0[dd] == 0.0) {
             return fixed; // rotation about a principal axis (the middle one included)
         }
-        let mc = (a / d(j[c], j[dd])).sqrt();
-        let mm = (a / d(j[mid], j[dd])).sqrt();
-        let md = (b / d(j[c], j[dd])).sqrt();
+        let mc = (a / d_cd).sqrt();
+        let mm = (a / d_md).sqrt();
+        let md = (b / d_cd).sqrt();
         let sign = |x: f64| if x < 0.0 { -1.0 } else { 1.0 };
-        let sigma_c = if k2 < 1.0 { 1.0 } else { sign(m0[c]) };
+        let (k2, k1) = (k2.min(1.0), k1.clamp(0.0, 1.0));
+        let sigma_c = if k1 > 0.0 { 1.0 } else { sign(m0[c]) };
         let sigma_d = sign(m0[dd]);
-        let k2 = k2.min(1.0);
         let eps = levi_civita(c, mid, dd);
-        let lambda =
-            eps * sigma_c * sigma_d * (j[mid] - j[dd]).signum() * (b * d(j[mid], j[dd])).sqrt();
+        // sgn(J_mid − J_d): J_mid > J_hi, J_mid < J_lo.
+        let s_md = if dd == hi { 1.0 } else { -1.0 };
+        let lambda = eps * sigma_c * sigma_d * s_md * (b * d_md).sqrt();
         // (sn, cn, dn) at the start, read off m0: the amplitudes make them so.
         let start = Jacobi {
             s: m0[mid] / mm,
@@ -160,6 +178,7 @@ impl FreeRigidBody {
                 axes: [c, mid, dd],
                 amp: [sigma_c * mc, mm, sigma_d * md],
                 k2,
+                k1,
                 lambda,
                 start,
             }),
@@ -193,7 +212,7 @@ impl FreeRigidBody {
             Some(o) => {
                 let adv = |x: f64| o.advance(x * t);
                 let end = |a: &Jacobi, b: &Jacobi, tot: f64| {
-                    a.add(b, o.k2).unwrap_or_else(|| o.advance(tot * t))
+                    a.add(b, o.k2, o.k1).unwrap_or_else(|| o.advance(tot * t))
                 };
                 match order {
                     MagnusOrder::Two => {
@@ -217,8 +236,8 @@ impl FreeRigidBody {
                         // Nodes 1/2 ∓ r from (sn, cn, dn) at 1/2 and at r: two evaluations.
                         let r = 15f64.sqrt() / 10.0;
                         let (a2, ar) = (adv(0.5), adv(r));
-                        let a1 = a2.add(&ar.neg(), o.k2).unwrap_or_else(|| adv(0.5 - r));
-                        let a3 = a2.add(&ar, o.k2).unwrap_or_else(|| adv(0.5 + r));
+                        let a1 = a2.add(&ar.neg(), o.k2, o.k1).unwrap_or_else(|| adv(0.5 - r));
+                        let a3 = a2.add(&ar, o.k2, o.k1).unwrap_or_else(|| adv(0.5 + r));
                         let e = end(&a2, &a2, 1.0);
                         (
                             magnus_from_samples(
@@ -252,6 +271,8 @@ struct OrbitData {
     /// Signed amplitudes σ_c M_c, M_mid, σ_d M_d.
     amp: [f64; 3],
     k2: f64,
+    /// `k'² = 1 − k²`, formed without cancellation (see [`FreeRigidBody::orbit`]).
+    k1: f64,
     lambda: f64,
     /// `(sn, cn, dn)` of the phase at the start.
     start: Jacobi,
@@ -266,8 +287,8 @@ struct Jacobi {
 }
 
 impl Jacobi {
-    fn at(u: f64, k2: f64) -> Self {
-        let (s, c, d) = jacobi(u, k2);
+    fn at(u: f64, k2: f64, k1: f64) -> Self {
+        let (s, c, d) = jacobi_m1(u, k2, k1);
         Self { s, c, d }
     }
 
@@ -285,9 +306,10 @@ impl Jacobi {
     /// `None` when that denominator is
     /// below 1/2 (near the separatrix, with both arguments near a quarter period), where it
     /// would cost digits: the caller then evaluates directly. `dn` is recomputed as
-    /// `sqrt(k₁² + k² cn²)`, as in [`jacobi`], to keep its relative accuracy as `k² → 1`.
-    fn add(&self, o: &Jacobi, k2: f64) -> Option<Jacobi> {
-        self.add_above(o, k2, 0.5)
+    /// `sqrt(k'² + k² cn²)` (`k1 = k'²`), as in [`jacobi_m1`], to keep its relative accuracy as
+    /// `k² → 1`.
+    fn add(&self, o: &Jacobi, k2: f64, k1: f64) -> Option<Jacobi> {
+        self.add_above(o, k2, k1, 0.5)
     }
 
     /// [`Self::add`] with any positive denominator: the last resort where the direct
@@ -295,7 +317,7 @@ impl Jacobi {
     /// unstable middle axis, `sn ν = ±1` with `k² = 1`: `ν = F(π/2 | 1)` is infinite). The
     /// algebra is exact; its cost in digits is bounded by the size of the denominator,
     /// `sech²(λt)` there, which is far from zero for any step a simulation takes.
-    fn add_above(&self, o: &Jacobi, k2: f64, min_den: f64) -> Option<Jacobi> {
+    fn add_above(&self, o: &Jacobi, k2: f64, k1: f64, min_den: f64) -> Option<Jacobi> {
         // 1 − k² sn²u sn²v = cn²v + sn²v dn²u: a sum of non-negative terms, free of the
         // cancellation of the first form next to the separatrix.
         let den = o.c * o.c + (o.s * o.s) * (self.d * self.d);
@@ -305,7 +327,7 @@ impl Jacobi {
         let inv = 1.0 / den;
         let s = (self.s * o.c * o.d + o.s * self.c * self.d) * inv;
         let c = (self.c * o.c - self.s * o.s * self.d * o.d) * inv;
-        let d = ((1.0 - k2) + k2 * c * c).sqrt();
+        let d = (k1 + k2 * (c * c)).sqrt();
         Some(Jacobi { s, c, d })
     }
 }
@@ -313,17 +335,20 @@ impl Jacobi {
 impl OrbitData {
     /// `(sn, cn, dn)` of the phase advance `λ t` alone (not of the phase `λ t + ν`).
     fn advance(&self, t: f64) -> Jacobi {
-        Jacobi::at(self.lambda * t, self.k2)
+        Jacobi::at(self.lambda * t, self.k2, self.k1)
     }
 
     /// `(sn, cn, dn)(λt + ν)` evaluated directly, with the start phase
-    /// `ν = F(φ₀ | k²)`, `φ₀ = atan2(sn ν, cn ν)`: needed only where the addition theorem is
-    /// avoided. `None` if `ν` cannot be computed.
+    /// `ν = F(φ₀ | k²)`, `φ₀ = am ν`: needed only where the addition theorem is avoided. `ν` is
+    /// computed from `(sn ν, cn ν, dn ν)` themselves ([`ellipf_scd`]), not from `φ₀`: next to the
+    /// middle axis `φ₀ → π/2` and `dn ν → 0`, where `F`'s slope `1/dn ν` would multiply the
+    /// rounding of `φ₀`. `None` if `ν` cannot be computed.
     fn direct(&self, t: f64) -> Option<Jacobi> {
-        let nu = ellipf(self.start.s.atan2(self.start.c), self.k2)
+        let Jacobi { s, c, d } = self.start;
+        let nu = ellipf_scd(s, c, d, self.k1)
             .ok()
             .filter(|v| v.is_finite())?;
-        Some(Jacobi::at(self.lambda * t + nu, self.k2))
+        Some(Jacobi::at(self.lambda * t + nu, self.k2, self.k1))
     }
 
     /// The momentum with the given `(sn, cn, dn)` of its phase.
@@ -360,8 +385,8 @@ impl Orbit {
         let Some(o) = &self.data else {
             return self.m0;
         };
-        let j = o.start.add(adv, o.k2).or_else(|| o.direct(t));
-        match j.or_else(|| o.start.add_above(adv, o.k2, f64::MIN_POSITIVE)) {
+        let j = o.start.add(adv, o.k2, o.k1).or_else(|| o.direct(t));
+        match j.or_else(|| o.start.add_above(adv, o.k2, o.k1, f64::MIN_POSITIVE)) {
             Some(j) => o.momentum(&j),
             None => Vector3::from_element(f64::NAN),
         }
@@ -383,10 +408,15 @@ impl Orbit {
         self.data.map(|o| o.k2)
     }
 
+    /// `k'² = 1 − k²` of the orbit, to round-off relative to itself (`None` for a fixed point).
+    pub fn complementary_parameter(&self) -> Option<f64> {
+        self.data.map(|o| o.k1)
+    }
+
     /// Period of the momentum, `4K(k²)/|λ|` (infinite on the separatrix, `None` at a fixed point).
     pub fn period(&self) -> Option<f64> {
         self.data
-            .map(|o| 4.0 * crate::lie::elliptic::ellipk(o.k2).unwrap_or(f64::INFINITY) / o.lambda.abs())
+            .map(|o| 4.0 * ellipk_m1(o.k1).unwrap_or(f64::INFINITY) / o.lambda.abs())
     }
 }
 
@@ -696,6 +726,51 @@ mod tests {
             // Q m is conserved by the exact flow; Magnus-6 with h = 0.1 keeps it to ~1e-9.
             prop_assert!((q * m - m0).norm() < 1e-8 * m0.norm().max(1e-3));
         }
+    }
+
+    /// Issue 16, item 2: next to the middle (unstable) axis, k² = 1 − 1.3e-14, and 1 − k² formed
+    /// as `1 − num/den` kept two of its digits (the third component was off by 2.3e-11 of |m|
+    /// at t = 0.5 and 1.9e-5 at t = 50); the start phase read through `φ₀ = atan2(sn, cn)` then
+    /// cost 5e-12 more, F's slope being 1/dn ν ≈ 4e6 there. References: mpmath's ODE solver at
+    /// 30 digits (and the closed form at 50, scripts/gen_rigid_body_refs.py), which agree to
+    /// 1e-31. Perturbing any input by one ulp moves these solutions by about 2.2e-16 |m0|.
+    #[test]
+    fn next_to_the_middle_axis_the_orbit_keeps_its_digits() {
+        let body = FreeRigidBody::new(Vector3::new(1.0, 2.0, 3.0)).unwrap();
+        // (m0, t, m(t), the solution's own sensitivity to one ulp in any input)
+        let cases: [([f64; 3], f64, [f64; 3], f64); 7] = [
+            // the issue's input
+            ([1e-7, 1.0, 2e-7], 0.5, [8.431887902349233e-8, 1.0000000000000058, 1.7700005672127622e-7], 2.2e-16),
+            ([1e-7, 1.0, 2e-7], 5.0, [-7.318189973321318e-9, 1.00000000000002, 1.0080013746745022e-7], 2.2e-16),
+            ([1e-7, 1.0, 2e-7], 50.0, [-0.014350705855544625, 0.9995880296231195, 0.02485615166648064], 2.4e-16),
+            // around it: the other side of the separatrix (k² from the other case), m_mid < 0
+            ([2e-7, -1.0, 1e-7], 0.5, [2.1044925141844245e-7, -0.9999999999999915, 1.5121726841782456e-7], 2.2e-16),
+            ([2e-7, -1.0, 1e-7], 50.0, [0.2262002088408769, -0.8918149259131822, 0.3917902543949492], 1.5e-15),
+            // within 1e-9 of the separatrix as well as next to the axis
+            (
+                [1e-7, 1.0, 5.7735026976697607e-8],
+                30.0,
+                [0.00019230000503864445, 0.9999999260414334, -0.00033307333899146204],
+                2.2e-16,
+            ),
+            ([1e-7, 1.0, 2e-7], 0.0, [1e-7, 1.0, 2e-7], 0.0),
+        ];
+        for (m0, t, want, sens) in cases {
+            let (m0, want) = (Vector3::from(m0), Vector3::from(want));
+            let bound = 4.0 * sens.max(f64::EPSILON * m0.norm());
+            let orbit = body.orbit(&m0);
+            for (path, m) in [("addition", orbit.momentum(t)), ("direct", orbit.momentum_direct(t))] {
+                let err = (m - want).norm();
+                assert!(err <= bound, "{m0:?} t={t} ({path}): {m:?}, error {err:e}");
+            }
+            for order in [MagnusOrder::Two, MagnusOrder::Six] {
+                let (m, _) = body.flow(&m0, &Matrix3::identity(), t, order);
+                assert!((m - want).norm() <= bound, "{m0:?} t={t} flow {order:?}: {m:?}");
+            }
+        }
+        // k'² itself, to round-off: 1 − k² = |J1 − J3| (m3² |J2 − J3| − m1² |J1 − J2|) / den.
+        let k1 = body.orbit(&Vector3::new(1e-7, 1.0, 2e-7)).complementary_parameter().unwrap();
+        assert!((k1 - 1.3333333333332621e-14).abs() <= 4.0 * f64::EPSILON * k1, "k'² = {k1:e}");
     }
 
     #[test]

@@ -110,8 +110,19 @@ pub fn from_euler_zyx(e: &Vector3<f64>) -> Matrix3<f64> {
 /// `phi, psi ∈ (−π, π]`.
 ///
 /// Read directly from the entries of `Q`, so a matrix that is only nearly orthogonal (an explicit
-/// Runge–Kutta attitude) still gets angles. The pitch uses `atan2` on `−Q31` against the norm of
-/// the first column's other entries, which stays accurate near ±π/2 where `asin` would not.
+/// Runge–Kutta attitude) still gets angles. The pitch uses `atan2` on `−Q31` against
+/// `ρ = |(Q11, Q21)| = cos θ`, which stays accurate near ±π/2 where `asin` would not; the yaw is
+/// `atan2(Q21, Q11)`; the roll is `atan2(Q32, Q33)` while `ρ ≥ |Q31|/2` (`|θ| ≤ 63°`). Beyond, `Q32 = cos θ sin φ`
+/// and `Q33 = cos θ cos φ` shrink with `ρ` while their round-off does not, and the roll is read
+/// from the second row of `Rz(ψ)ᵀ Q = Ry(θ) Rx(φ)`, `(0, cos φ, −sin φ)`, that is
+/// `atan2(Q21 Q13 − Q11 Q23, Q11 Q22 − Q21 Q12)` (for a rotation these are the cofactors of
+/// `Q32, Q33`): it keeps the roll consistent with whatever yaw the round-off of `(Q11, Q21)`
+/// gives, and the angles rebuild `Q` to round-off at every pitch.
+///
+/// **Gimbal lock** (`ρ ≤ 4 ε`, the pitch within round-off of ±π/2): `Q` depends on `ψ ∓ φ`
+/// only, and the direction of `(Q11, Q21)` is round-off. The roll is then set to 0 (scipy's
+/// convention: the third angle of its `"ZYX"` sequence) and the yaw read from
+/// `Rz(ψ) Ry(±π/2)`: `ψ = atan2(−Q12, Q22)`.
 pub fn euler_zyx(q: &Matrix3<f64>) -> Vector3<f64> {
     let rho = (q[(0, 0)] * q[(0, 0)] + q[(1, 0)] * q[(1, 0)]).sqrt();
     euler_zyx_with(q, rho)
@@ -120,11 +131,28 @@ pub fn euler_zyx(q: &Matrix3<f64>) -> Vector3<f64> {
 /// [`euler_zyx`] given `rho = |(Q11, Q21)|` (shared with `W` by [`euler_and_w`]).
 /// `atan2` is musl's (the `libm` crate, within 1 ulp).
 fn euler_zyx_with(q: &Matrix3<f64>, rho: f64) -> Vector3<f64> {
-    let phi = libm::atan2(q[(2, 1)], q[(2, 2)]);
     let theta = libm::atan2(-q[(2, 0)], rho);
-    let psi = libm::atan2(q[(1, 0)], q[(0, 0)]);
+    let (q00, q10, q20) = (q[(0, 0)], q[(1, 0)], q[(2, 0)].abs());
+    let psi = libm::atan2(q10, q00);
+    if rho >= 0.5 * q20 {
+        // |θ| ≤ 63°: Q32, Q33 are at least half of (sin φ, cos φ), as good as the cofactors.
+        return Vector3::new(libm::atan2(q[(2, 1)], q[(2, 2)]), theta, psi);
+    }
+    if rho <= GIMBAL_LOCK * q20 {
+        // gimbal lock: roll 0, the yaw from Rz(ψ) Ry(±π/2)
+        return Vector3::new(0.0, theta, libm::atan2(-q[(0, 1)], q[(1, 1)]));
+    }
+    let phi = libm::atan2(
+        q10 * q[(0, 2)] - q00 * q[(1, 2)],
+        q00 * q[(1, 1)] - q10 * q[(0, 1)],
+    );
     Vector3::new(phi, theta, psi)
 }
+
+/// `cos θ` at and below which [`euler_zyx`] treats the pitch as ±π/2 (gimbal lock): 4 ε, about
+/// the round-off of the entries of a rotation built by a few products. Setting the roll to 0
+/// there moves the rebuilt matrix by at most about `2ρ ≤ 8 ε`.
+pub const GIMBAL_LOCK: f64 = 4.0 * f64::EPSILON;
 
 /// The ZYX Euler angles of `q` and `W = Pi_e(theta)⁻¹ q` (the controller's map from body
 /// angular velocity to Euler-angle rates), with the trigonometric functions of the angles
@@ -334,6 +362,55 @@ mod tests {
         }
     }
 
+    /// Issue 16, item 3: at gimbal lock the entries Q11, Q21, Q32, Q33 are round-off, and
+    /// reading roll and yaw from them gave (0, 1.5708, −0.98279), which rebuilds a matrix 0.385
+    /// away. The matrix is scipy's `Rotation.from_euler("ZYX", [−1.1, fl(π/2), 0.3])`, entry
+    /// for entry (its round-off included); scipy returns (0, π/2, −1.4) for it.
+    #[test]
+    fn gimbal_lock_gets_its_own_branch_and_rebuilds_the_matrix() {
+        let q = Matrix3::new(
+            1.1102230246251565e-16,
+            0.9854497299884601,
+            0.16996714290024073,
+            -1.6653345369377348e-16,
+            0.1699671429002408,
+            -0.98544972998846,
+            -0.9999999999999998,
+            0.0,
+            2.7755575615628914e-16,
+        );
+        let e = euler_zyx(&q);
+        assert_eq!(e.x, 0.0);
+        assert!((e.y - std::f64::consts::FRAC_PI_2).abs() < 1e-15, "{e}");
+        assert!((e.z + 1.4).abs() < 1e-15, "{e}");
+        assert!(
+            (from_euler_zyx(&e) - q).norm() < 1e-15,
+            "{}",
+            (from_euler_zyx(&e) - q).norm()
+        );
+        // Around it: both signs of the pitch, every roll and yaw, the matrices built here and
+        // through quaternions, and pitches 1e-17 ... 1e-3 away from ±π/2.
+        for sign in [1.0, -1.0] {
+            for off in [0.0, 1e-17, 1e-15, 1e-13, 1e-10, 1e-7, 1e-3] {
+                for (phi, psi) in [(0.3, -1.1), (-2.9, 3.0), (1.0, 1.0), (0.0, 0.5)] {
+                    let th = sign * (std::f64::consts::FRAC_PI_2 - off);
+                    let r = from_euler_zyx(&Vector3::new(phi, th, psi));
+                    let via_quaternion = rodrigues(&quaternion(&r));
+                    for m in [r, via_quaternion] {
+                        let e = euler_zyx(&m);
+                        let back = from_euler_zyx(&e);
+                        assert!((back - m).norm() < 4e-15, "{sign} {off} {phi} {psi}: {e}");
+                        assert!(e.y.abs() <= std::f64::consts::FRAC_PI_2);
+                    }
+                }
+            }
+        }
+        // A pitch of exactly ±π/2 (entries 0, no round-off at all).
+        let exact = Matrix3::new(0.0, 0.0, 1.0, 0.0, 1.0, 0.0, -1.0, 0.0, 0.0); // Ry(π/2)
+        let e = euler_zyx(&exact);
+        assert!((from_euler_zyx(&e) - exact).norm() < 1e-15, "{e}");
+    }
+
     #[test]
     fn bjorck_step_squares_the_defect() {
         let r = exp(&Vector3::new(0.3, -0.2, 0.9));
@@ -403,6 +480,15 @@ mod tests {
         fn euler_angles_roundtrip(phi in -3.0f64..3.0, th in -1.5f64..1.5, psi in -3.0f64..3.0) {
             let e = Vector3::new(phi, th, psi);
             prop_assert!((euler_zyx(&from_euler_zyx(&e)) - e).norm() < 1e-13);
+        }
+
+        #[test]
+        fn euler_angles_rebuild_every_rotation(w in v3().prop_map(|v| v * 3.1)) {
+            // Pinocchio-style round trip over all of SO(3), gimbal lock included.
+            let r = exp(&w);
+            let e = euler_zyx(&r);
+            prop_assert!((from_euler_zyx(&e) - r).norm() < 4e-15);
+            prop_assert!(e.y.abs() <= std::f64::consts::FRAC_PI_2 && e.x.abs() <= std::f64::consts::PI);
         }
     }
 }
