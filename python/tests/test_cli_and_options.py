@@ -144,7 +144,7 @@ def test_vector_field_binding_matches_the_independent_model():
 def test_chunked_cli_output_equals_one_simulate_call(tmp_path):
     assert main(["simulate", "--out", str(tmp_path), "--no-plot", "--save-every", "3"]) == 0
     s = phsplit.simulate(phsplit.Vessel.paper(), save_every=3)
-    with xr.open_dataset(tmp_path / "fig2.nc") as ds:
+    with xr.open_dataset(tmp_path / "fig2-s3.nc") as ds:  # the command-line option is in the name
         np.testing.assert_array_equal(ds["time"].values, s.t)
         np.testing.assert_array_equal(ds["position"].values, s.x)
         np.testing.assert_array_equal(ds["energy_dissipated"].values, s.ledger.dissipated)
@@ -158,9 +158,10 @@ def test_sigterm_during_simulate_leaves_a_valid_file_with_the_steps_so_far(tmp_p
     p = subprocess.Popen([sys.executable, "-m", "phsplit", "simulate", "--out", str(tmp_path), "--no-plot",
                           "--t-end", "400000", "--h", "0.05", "--save-every", "200", "--linear-flow", "gauss"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    part = tmp_path / "fig2.nc.part"
+    name = "fig2-h0.05-t400000-s200-gauss"  # the command-line options are in the name
+    parts = lambda: list(tmp_path.glob(f".{name}.*.nc.part"))  # noqa: E731 - unique per run
     deadline = time.monotonic() + 120
-    while not part.exists():
+    while not parts():
         assert p.poll() is None, p.communicate()
         assert time.monotonic() < deadline
         time.sleep(0.05)
@@ -169,8 +170,8 @@ def test_sigterm_during_simulate_leaves_a_valid_file_with_the_steps_so_far(tmp_p
     _, err = p.communicate(timeout=60)
     assert p.returncode == 130, err
     assert "interrupted after" in err
-    assert not part.exists()
-    with xr.open_dataset(tmp_path / "fig2.nc") as ds:
+    assert not parts()
+    with xr.open_dataset(tmp_path / f"{name}.nc") as ds:
         assert ds.attrs["status"] == "interrupted"
         n = ds.sizes["time"]
         assert 1 < n < 400000 / 0.05 / 200 + 1

@@ -114,3 +114,48 @@ def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
     assert files == sorted(f"{i}.nc" for i in ids)  # every case exactly once, no temporary files
     with xr.open_dataset(store / "summary.nc") as s:
         assert list(s["status"].values) == ["completed"] * 12
+
+
+# Issue 13, item 1: a case's identity covers everything that determines its result.
+OTHER_VALUE = {"t_span": (0.0, 20.0), "h": 0.25, "method": "rk4", "control_start": None, "outer": "conservative",
+               "save_every": 5, "linear_flow": "gauss", "ledger": False}
+
+
+def test_every_setting_vessel_and_version_enters_the_case_id(monkeypatch):
+    base = Sweep(SHORT, phsplit.Vessel.paper(), [{"vessel.mass": 6e6}, {"vessel.mass": 7e6}])
+    ids = {base.case_id(i) for i in range(2)}
+    assert set(OTHER_VALUE) == set(Settings.__dataclass_fields__), "a new setting needs a value here"
+    from dataclasses import replace
+
+    for k, v in OTHER_VALUE.items():
+        other = Sweep(replace(SHORT, **{k: v}), base.base, base.cases)
+        assert other.settings.checked()[k] != base.settings.checked()[k]
+        assert ids.isdisjoint(other.case_id(i) for i in range(2)), f"changing {k} reused a case"
+    # an alias of the same method is the same run, and keeps its ids
+    assert {Sweep(replace(SHORT, method="strang"), base.base, base.cases).case_id(i) for i in range(2)} == ids
+    d = base.base.to_dict()
+    d["control"]["kd_translational"] = [1.0, 1.0, 1.0]
+    assert ids.isdisjoint(Sweep(SHORT, phsplit.Vessel.from_dict(d), base.cases).case_id(i) for i in range(2))
+    d = base.base.to_dict()
+    d["external"] = {"force": [1e3, 0.0, 0.0]}
+    assert ids.isdisjoint(Sweep(SHORT, phsplit.Vessel.from_dict(d), base.cases).case_id(i) for i in range(2))
+    monkeypatch.setattr(phsplit.batch._core, "__version__", "0.0.0-other")
+    assert ids.isdisjoint(base.case_id(i) for i in range(2))
+
+
+def test_a_sweep_rerun_with_other_settings_recomputes_every_case(tmp_path):
+    """The failure of issue 13: sp2 on [0, 100], then rk4 on [0, 20] in the same store."""
+    f = tmp_path / "gains.toml"
+    f.write_text(SWEEP_TOML.format(t_end=100.0, h=0.5).replace("[-1.0, 6e6, 7e6]", "[6e6]"))
+    store = tmp_path / "gains.store"
+    assert main(["sweep", str(f), "--out", str(store), "--workers", "1", "--no-progress"]) == 0
+    f.write_text(f.read_text().replace('"sp2"', '"rk4"').replace("[0.0, 100.0]", "[0.0, 20.0]"))
+    sw = load_sweep(str(f))
+    res = run_sweep(sw, str(store), n_workers=1, progress=False)
+    assert res["computed"] == 3 and res["reused"] == 0
+    for i in range(3):
+        with xr.open_dataset(store / "cases" / f"{sw.case_id(i)}.nc") as ds:
+            assert float(ds["time"][-1]) == 20.0
+    import json
+
+    assert json.loads((store / "sweep.json").read_text())["settings"]["method"] == "rk4"

@@ -168,8 +168,20 @@ class Sweep:
     cases: list[dict[str, float]] = field(default_factory=list)
     name: str = "sweep"
 
+    def identity(self) -> dict[str, Any]:
+        """Everything besides a case's own parameters that determines its result: the run
+        settings as the core reads them (aliases resolved), the base vessel with every
+        component's parameters (environment and loads included) and the phsplit version."""
+        settings = dict(self.settings.checked())
+        settings.pop("name", None)  # names the output, changes no number
+        return {"phsplit": _core.__version__, "settings": settings, "vessel": self.base.to_dict()}
+
     def case_id(self, i: int) -> str:
-        digest = hashlib.sha1(json.dumps(self.cases[i], sort_keys=True).encode()).hexdigest()[:8]
+        """``case_<index>_<digest>``, the digest over the case's parameters and :meth:`identity`:
+        a rerun with any other setting, vessel or version gets other ids, so the store never
+        hands back a result computed under different conditions (issue 13)."""
+        key = json.dumps({"case": self.cases[i], **self.identity()}, sort_keys=True, default=repr)
+        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
         return f"case_{i:05d}_{digest}"
 
 
@@ -297,11 +309,15 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
         if f.startswith(".tmp-"):
             os.unlink(os.path.join(store, "cases", f))  # left by a client that was killed mid-write
     ids = [sweep.case_id(i) for i in range(len(sweep.cases))]
-    have = done_cases(store)
+    have = done_cases(store)  # cases of other settings stay in the store under their own ids, unused
     todo = [i for i, cid in enumerate(ids) if cid not in have]
-    with open(os.path.join(store, "sweep.json"), "w") as f:
-        json.dump({"name": sweep.name, "settings": sweep.settings.__dict__, "cases": dict(zip(ids, sweep.cases))},
-                  f, indent=1, default=str)
+    from .plotting import publish
+
+    fd, tmp = tempfile.mkstemp(dir=store, prefix=".tmp-", suffix=".json")
+    with os.fdopen(fd, "w") as f:
+        json.dump({"name": sweep.name, **sweep.identity(), "cases": dict(zip(ids, sweep.cases))},
+                  f, indent=1, default=repr)
+    publish(tmp, os.path.join(store, "sweep.json"))  # whole or not at all
     cluster = None
     t0 = time.perf_counter()
     if todo:

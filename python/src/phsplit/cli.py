@@ -32,8 +32,10 @@ def _parser() -> argparse.ArgumentParser:
         "simulate",
         help="run a scenario (default: the paper's Fig. 2) and write NetCDF + PNG",
         description="Run a scenario and write <out>/<name>.nc (xarray/NetCDF) and <out>/<name>.png. "
-        "The NetCDF file is built as <name>.nc.part and renamed when closed: Ctrl-C or SIGTERM "
-        "leaves either no file or a valid one with the steps computed so far.",
+        "Options given on the command line are appended to the name (fig2-rk4-h0.25.nc). "
+        "The NetCDF file is built under a unique temporary name and renamed when closed: Ctrl-C or "
+        "SIGTERM leaves either no file or a valid one with the steps computed so far; a second run "
+        "writing the same output at the same time is refused.",
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -91,6 +93,52 @@ def _chunks(n: int, save_every: int, target: int = 100, min_steps: int = 20_000)
         out.append(min(size, n))
         n -= out[-1]
     return out
+
+
+def _override_suffix(args) -> str:
+    """What the command line changed, appended to the output name, so that runs of one scenario
+    with different options do not overwrite each other (fig2-rk4-h0.25.nc)."""
+    parts = []
+    if args.method:
+        parts.append(args.method.lower())
+    if args.h is not None:
+        parts.append(f"h{args.h:g}")
+    if args.t_end is not None:
+        parts.append(f"t{args.t_end:g}")
+    if args.save_every is not None:
+        parts.append(f"s{args.save_every}")
+    if args.linear_flow is not None:
+        parts.append(args.linear_flow)
+    if args.control_start is not None:
+        parts.append(f"c{args.control_start}")
+    import re
+
+    # Only the characters a scenario name may hold (the values were validated before this).
+    return "".join("-" + re.sub(r"[^A-Za-z0-9._-]", "_", x) for x in parts)
+
+
+class _OutputLock:
+    """An exclusive lock on <out>/.<name>.lock for the whole run: two processes writing the same
+    output never interleave; the second is told so and stops before touching anything."""
+
+    def __init__(self, out: str, name: str):
+        import fcntl
+
+        path = os.path.join(out, f".{name}.lock")
+        try:
+            self.f = open(path, "a")
+        except OSError as e:
+            raise UsageError(f"cannot create {path!r}: {e.strerror}") from None
+        try:
+            fcntl.flock(self.f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.f.close()
+            raise UsageError(f"another phsplit run is writing {os.path.join(out, name)}.nc right now; "
+                             "wait for it to finish, or choose another --out or scenario name") from None
+
+    def release(self) -> None:
+        if not self.f.closed:
+            self.f.close()  # closing drops the lock; the empty lock file stays (harmless, hidden)
 
 
 class _DeferSignals:
@@ -154,13 +202,16 @@ def _simulate(args) -> int:
         raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
     if not os.access(out, os.W_OK):
         raise UsageError(f"output folder {out!r} is not writable")
+    name = sc.name + _override_suffix(args)
+    nc = os.path.join(out, f"{name}.nc")
+    lock = _OutputLock(out, name)  # a second run writing the same output is refused, not mixed in
     t0, t1 = sc.t_span
     ctl = "never" if sc.control_start is None else f"t={sc.control_start:g} s"
     print(f"phsplit {phsplit.__version__}: {sc.name}: {sc.method} h={sc.h:g} s on "
           f"[{t0:g}, {t1:g}] s ({n} steps), controller from {ctl}; components: "
           f"{', '.join(sc.vessel.components)}", flush=True)
-    nc = os.path.join(out, f"{sc.name}.nc")
-    part = nc + ".part"
+    fd, part = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".nc.part")  # unique per run
+    os.close(fd)
     t_start = time.perf_counter()
     state = sc.vessel.initial_state()
     t = t0
@@ -204,6 +255,7 @@ def _simulate(args) -> int:
                 publish(part, nc)
             elif os.path.exists(part):
                 os.unlink(part)
+            lock.release()
     dt = time.perf_counter() - t_start
     if status == "interrupted":
         if sols:
@@ -214,7 +266,7 @@ def _simulate(args) -> int:
     last = sols[-1]
     files = [nc]
     if not args.no_plot:
-        png = os.path.join(out, f"{sc.name}.png")
+        png = os.path.join(out, f"{name}.png")
         plot_positions(_concat(sols), png, reference_of(sc.vessel))
         files.append(png)
     e = last.euler[-1]

@@ -128,7 +128,7 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
             raise type(e)(f"{path}: {e}") from None
     else:
         vessel = base
-    name = checked.get("name") or os.path.splitext(os.path.basename(path))[0]
+    name = checked.get("name") or _name_of_file(path)
     return Scenario(vessel=vessel, settings=settings, name=name, path=path)
 
 
@@ -136,3 +136,13 @@ def load(path: str | os.PathLike[str]) -> Scenario:
     """Read and validate a scenario file."""
     p = os.fspath(path)
     return from_dict(_read_toml(p, "scenario file"), p)
+
+
+def _name_of_file(path: str) -> str:
+    """An output name from a scenario's file name, confined to the characters a ``name`` may hold
+    (letters, digits, '.', '_', '-', starting with a letter or digit, at most 100)."""
+    import re
+
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(path))[0])
+    stem = stem.lstrip("._-")[:100]
+    return stem or "scenario"
