@@ -62,8 +62,52 @@ def _reflected():
     return y
 
 
+class CliError(Exception):
+    """What the CLI printed for a bad input: its one-line error (exit status 2, no traceback)."""
+
+
+def cli(*args: str, files: dict[str, bytes] | None = None) -> Callable[[], object]:
+    """Run ``phsplit <args>`` in a fresh folder (holding ``files``) with ``--out out``-style
+    arguments relative to it. Raises :class:`CliError` with the message when the CLI exits 2
+    with one line on stderr and no traceback and wrote nothing outside the folder; anything else
+    (exit 0, a traceback, a stray file) is returned or raised as an AssertionError, which the
+    catalogue's test reports."""
+
+    def run():
+        import contextlib
+        import io
+
+        from phsplit.cli import main
+
+        here = os.getcwd()
+        with tempfile.TemporaryDirectory() as top:
+            d = os.path.join(top, "work")
+            os.makedirs(d)
+            for name, data in (files or {}).items():
+                with open(os.path.join(d, name), "wb") as f:
+                    f.write(data)
+            err, out = io.StringIO(), io.StringIO()
+            os.chdir(d)
+            try:
+                with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+                    code = main(list(args))
+            finally:
+                os.chdir(here)
+            stray = [n for n in os.listdir(top) if n != "work"]
+            lines = err.getvalue().strip().splitlines()
+        assert not stray, f"wrote outside the working folder: {stray}"
+        assert "Traceback" not in err.getvalue(), err.getvalue()
+        if code == 2 and len(lines) == 1 and lines[0].startswith("phsplit: error: "):
+            raise CliError(lines[0][len("phsplit: error: "):])
+        return code, err.getvalue()
+
+    return run
+
+
 E = phsplit.InvalidInputError
 P = phsplit.ScenarioParseError
+C = CliError
+SIM = ("simulate", "--out", "out", "--no-plot")
 
 CATALOGUE: list[Bad] = [
     # vessel parameters
@@ -152,4 +196,44 @@ CATALOGUE: list[Bad] = [
         ("simulation.control_start", "never")),
     Bad("scenario gain that is not a gain", scenario("[control]\nkp_translational = [-1.0, 0.0, 0.0]\n"), E,
         ("control.kp_translational[0]", "≥ 0")),
+    # issue 13: the API
+    Bad("save_every given as a boolean", sim(save_every=True), E, ("save_every", "integer")),
+    Bad("Euler angles given as text", sim(initial={"euler": "abc"}), E, ("euler", "3 numbers")),
+    Bad("time span beyond what doubles resolve", sim(t_span=(1e17, 1e17 + 10.0)), E, ("h", "resolve", "t_span")),
+    Bad("time span to 1e308", sim(t_span=(0.0, 1e308)), E, ("steps", "at most")),
+    Bad("infinite end time", sim(t_span=(0.0, math.inf)), E, ("t_span", "finite")),
+    Bad("progress that is not a callable", sim(progress="yes"), E, ("progress", "callable")),
+    Bad("scenario name with a slash", scenario('[simulation]\nname = "a/b"\n'), E, ("simulation.name", "a/b")),
+    Bad("scenario name escaping the output folder", scenario('[simulation]\nname = "../../escape"\n'), E,
+        ("simulation.name", "inside the output folder")),
+    Bad("empty scenario name", scenario('[simulation]\nname = ""\n'), E, ("simulation.name", "1 to 100")),
+    Bad("scenario t_span to infinity", scenario("[simulation]\nt_span = [0.0, inf]\n"), E, ("t_span", "finite")),
+    Bad("scenario save_every as a boolean", scenario("[simulation]\nsave_every = true\n"), P,
+        ("save_every", "integer")),
+    # issue 13: the command line (one line on stderr, exit status 2, nothing written outside)
+    Bad("CLI: negative end time", cli(*SIM, "--t-end", "-5"), C, ("t_span", "t1 > t0")),
+    Bad("CLI: zero end time", cli(*SIM, "--t-end", "0"), C, ("t_span", "t1 > t0")),
+    Bad("CLI: end time shorter than a step", cli(*SIM, "--t-end", "0.1"), C, ("h = 0.5 s", "longer than t_span")),
+    Bad("CLI: step longer than the span", cli(*SIM, "--h", "250"), C, ("h = 250 s", "longer than t_span")),
+    Bad("CLI: zero step", cli(*SIM, "--h", "0"), C, ("h", "> 0")),
+    Bad("CLI: NaN end time", cli(*SIM, "--t-end", "nan"), C, ("t_span", "finite")),
+    Bad("CLI: infinite end time", cli(*SIM, "--t-end", "inf"), C, ("t_span", "finite")),
+    Bad("CLI: end time 1e308", cli(*SIM, "--t-end", "1e308"), C, ("steps", "at most")),
+    Bad("CLI: save every 0th step", cli(*SIM, "--save-every", "0"), C, ("save_every", ">= 1")),
+    Bad("CLI: unknown method", cli(*SIM, "--method", "rk45"), C, ("method", "rk45", "rk4")),
+    Bad("CLI: controller start as a word", cli(*SIM, "--control-start", "soon"), C,
+        ("--control-start", "'never'")),
+    Bad("CLI: binary scenario file", cli("simulate", "s.toml", "--out", "out", files={"s.toml": b"\x00\x01\xff\xfe"}),
+        C, ("s.toml", "UTF-8")),
+    Bad("CLI: scenario name escaping the output folder",
+        cli("simulate", "s.toml", "--out", "out", files={"s.toml": b'[simulation]\nname = "../../escape"\n'}), C,
+        ("simulation.name", "inside the output folder")),
+    Bad("CLI: scenario with t_span to infinity",
+        cli("simulate", "s.toml", "--out", "out", files={"s.toml": b"[simulation]\nt_span = [0, inf]\n"}), C,
+        ("t_span", "finite")),
+    Bad("CLI: missing scenario file", cli("simulate", "nowhere.toml", "--out", "out"), C, ("nowhere.toml",)),
+    Bad("CLI: output folder that is a file", cli(*SIM[:-3], "--out", "f", "--t-end", "1", files={"f": b"x"}), C,
+        ("output folder", "f")),
+    Bad("CLI: sweep without [sweep]", cli("sweep", "s.toml", "--out", "st", files={"s.toml": b"[simulation]\nh = 1.0\n"}),
+        C, ("[sweep]",)),
 ]

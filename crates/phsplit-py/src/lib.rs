@@ -188,6 +188,14 @@ impl PyVessel {
             .map(|a| (a.name, kind_name(a.kind)))
             .collect()
     }
+    /// The natural periods (s, ascending) of the oscillating modes of flow S2 linearised at
+    /// the attitude of a flat 27-vector `state`, with the controller on or off
+    /// (`VesselSystem::natural_periods`).
+    #[pyo3(signature = (state, control))]
+    fn natural_periods(&self, state: PyReadonlyArray1<'_, f64>, control: bool) -> PyResult<Vec<f64>> {
+        let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;
+        Ok(VesselSystem::new(&self.inner, None).natural_periods(&s.q, control))
+    }
     /// The stored energy H of eq. (35) at a flat 27-vector state (J).
     fn energy(&self, state: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
         let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;

@@ -23,7 +23,7 @@ from . import rigid_body, so3, special
 from .batch import simulate_many, with_parameters
 from .scenario import Scenario
 from .scenario import load as load_scenario
-from .simulate import Ledger, PassivityWarning, Settings, Solution, Vessel, simulate
+from .simulate import Ledger, PassivityWarning, Settings, Solution, StepSizeWarning, Vessel, simulate
 
 
 def method_info(name: str) -> dict:
@@ -42,6 +42,7 @@ __all__ = [
     "ScenarioParseError",
     "Settings",
     "Solution",
+    "StepSizeWarning",
     "Vessel",
     "__version__",
     "load_scenario",

@@ -389,6 +389,12 @@ def main(argv: list[str] | None = None) -> int:
 
     if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
         signal.signal(signal.SIGTERM, _sigterm)  # clean up staging files as on Ctrl-C
+    import warnings
+
+    def _show(message, category, filename, lineno, file=None, line=None):
+        print(f"phsplit: warning: {message}", file=sys.stderr)  # one line, no source location
+
+    warnings.showwarning = _show
     parser = _parser()
     args = parser.parse_args(argv)
     if args.command is None:

@@ -26,13 +26,14 @@ import re
 import shutil
 import tempfile
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from . import _core
-from .simulate import Vessel, simulate
+from .simulate import StepSizeWarning, Vessel, simulate
 
 SPLITTING = ("sp2", "sp4", "sp6")
 ORDERS = {"sp2": 2, "sp4": 4, "sp6": 6}
@@ -238,8 +239,10 @@ def run_stability(vessel: Vessel, s: Settings, res: Results, bar) -> None:
         res.stability[meth] = {}
         first_div = None
         for h in s.stability_h:
-            sol = simulate(vessel, (0.0, 200.0), h, meth, control_start=50.0, ledger=False,
-                           save_every=10**9)
+            with warnings.catch_warnings():  # the sweep takes steps beyond the periods on purpose
+                warnings.simplefilter("ignore", StepSizeWarning)
+                sol = simulate(vessel, (0.0, 200.0), h, meth, control_start=50.0, ledger=False,
+                               save_every=10**9)
             e_end = float(sol.energy[-1]) if sol.status == "completed" else math.inf
             e_max = float(np.max(sol.energy)) if sol.status == "completed" else math.inf
             diverged = not (e_max <= bound)

@@ -13,6 +13,11 @@ from . import _core
 
 
 
+class StepSizeWarning(UserWarning):
+    """The step is longer than half the vessel's shortest natural period: the run stays
+    passive and bounded (for the splitting methods) but cannot resolve that motion."""
+
+
 class PassivityWarning(UserWarning):
     """A composition with negative sub-steps created energy: its discrete map is passive only
     under the condition of the paper's Prop. 2.5, which this run does not meet."""
@@ -68,6 +73,12 @@ class Vessel:
     def components(self) -> list[str]:
         """The vessel's force components (ports), in the order they are assembled."""
         return self._inner.components()
+
+    def natural_periods(self, control: bool = True, **initial: Sequence[float]) -> list[float]:
+        """The natural periods (s, ascending) of the vessel's oscillating modes, flow S2
+        linearised at the initial attitude (or at ``initial_state(**initial)``'s), with the
+        controller on or off. For the paper's vessel: pitch 4.08, heave 4.25, roll 9.21 s."""
+        return list(self._inner.natural_periods(self.initial_state(**initial), bool(control)))
 
     @property
     def accounts(self) -> list[tuple[str, str]]:
@@ -296,6 +307,25 @@ def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray) ->
         "'sp2'/'lie', whose positive steps are passive for any h (Prop. 2.2)."), stacklevel=3)
 
 
+def _warn_if_step_too_long(vessel: "Vessel", y0: np.ndarray, settings: "Settings") -> None:
+    """Issue 13: a StepSizeWarning when h exceeds half the shortest natural period of the
+    vessel (flow S2 linearised at the initial attitude, with the controller as it will act):
+    fewer than two steps per period cannot represent that oscillation."""
+    try:
+        h = float(settings.checked()["h"])
+        state = vessel.initial_state() if y0 is None else y0
+        periods = vessel._inner.natural_periods(state, settings.control_start is not None)
+    except (_core.InvalidInputError, ValueError, TypeError):
+        return  # the core reports bad input when the run starts
+    if periods and h > 0.5 * periods[0]:
+        warnings.warn(StepSizeWarning(
+            f"h = {h:g} s is more than half the vessel's shortest natural period ({periods[0]:.3g} s; "
+            f"periods {', '.join(f'{p:.3g}' for p in periods[:4])} s): the run cannot resolve that motion. "
+            f"The splitting methods stay bounded and passive at such steps; take h < {0.5 * periods[0]:.3g} s to "
+            f"resolve it, and about a tenth of the period ({0.1 * periods[0]:.2g} s) to follow it accurately."),
+            stacklevel=3)
+
+
 _DEFAULTS = _core.default_settings()
 
 
@@ -351,8 +381,8 @@ def simulate(
     ``sp6`` (Blanes–Moan) or explicit Runge–Kutta ``euler``, ``heun``, ``rk4``. The controller
     acts from the first step that starts at or after ``control_start`` (``None``: never).
     ``outer`` chooses the outermost flow of a splitting: ``"dissipative"`` (S2, default) or
-    ``"conservative"`` (S1). The run takes ``floor((t1 - t0) / h)`` steps (to round-off) and
-    saves every ``save_every``-th step and the last. ``initial`` overrides the vessel's initial
+    ``"conservative"`` (S1). The run takes ``ceil((t1 - t0) / h)`` steps (to round-off), the
+    last one shorter when the span is not a whole number of steps, and saves every ``save_every``-th step and the last. ``initial`` overrides the vessel's initial
     state: a flat 27-vector or a mapping with ``euler``, ``position``, ``velocity``,
     ``angular_velocity``. ``linear_flow`` integrates the linear flow S2 exactly (``"exact"``,
     matrix exponentials) or by Gauss collocation of the method's order (``"gauss"``, the
@@ -407,6 +437,7 @@ def simulate(
     else:
         raise _core.InvalidInputError(f"progress must be True, False, None or a callable f(steps_done, n_steps), "
                                       f"got {type(progress).__name__}")
+    _warn_if_step_too_long(vessel, y0, settings)
     try:
         raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), cb)
     finally:

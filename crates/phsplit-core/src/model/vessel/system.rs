@@ -142,6 +142,40 @@ impl<'a> VesselSystem<'a> {
         b
     }
 
+    /// The natural periods (s) of the oscillating modes of flow S2 linearised at the attitude
+    /// `q`, with the controller `on` or off, ascending: `2π/|λ|` for each eigenvalue pair
+    /// `λ, λ̄` of the two 9×9 block systems (`u' = A_uu u + A_uv v + A_uw w`, `v' = A_vu u`,
+    /// `w' = A_wv v`) with `Im λ ≠ 0`. For a damped oscillator `|λ|` is its undamped natural
+    /// frequency, so the periods do not depend on the damping. Paper vessel, upright, controller
+    /// off: heave `2π √(mv/c)` = 4.25 s, pitch `2π √(T2/(mv g GM_L))` = 4.08 s, roll 9.21 s.
+    /// A step far beyond the shortest of them cannot resolve the motion (docs/model.md §4).
+    pub fn natural_periods(&self, q: &Matrix3<f64>, on: bool) -> Vec<f64> {
+        let b = self.s2_at(q, on, false);
+        let mut out = Vec::new();
+        for blk in &b.sys {
+            let mut a = nalgebra::SMatrix::<f64, 9, 9>::zeros();
+            a.fixed_view_mut::<3, 3>(0, 0).copy_from(&blk.auu);
+            a.fixed_view_mut::<3, 3>(0, 3).copy_from(&blk.auv);
+            a.fixed_view_mut::<3, 3>(0, 6).copy_from(&blk.auw);
+            a.fixed_view_mut::<3, 3>(3, 0).copy_from(&blk.avu);
+            a.fixed_view_mut::<3, 3>(6, 3).copy_from(&blk.awv);
+            // Balance by the momentum scale (u = M v): the raw entries span many decades.
+            let scale = a.abs().max().max(f64::MIN_POSITIVE);
+            let Some(ev) = (a / scale).try_schur(1e-15, 10_000).map(|s| s.complex_eigenvalues()) else {
+                continue;
+            };
+            for l in ev.iter() {
+                let (re, im) = (l.re * scale, l.im * scale);
+                let r = re.hypot(im);
+                if im > 1e-9 * r && r > 0.0 {
+                    out.push(2.0 * std::f64::consts::PI / r);
+                }
+            }
+        }
+        out.sort_by(|x, y| x.total_cmp(y));
+        out
+    }
+
     /// The block states of `s`: translation `(p, x − x_o, phi_x)`, rotation `(m, mu, phi_th)`.
     fn blocks_of(&self, s: &VesselState) -> [Z3; 2] {
         [[s.p, s.x - self.origin, s.phi_x], [s.m, s.mu, s.phi_th]]
@@ -450,6 +484,32 @@ mod tests {
     }
     fn scalar(v: &Vessel, key: &str) -> f64 {
         v.params["vessel"][key].as_float().unwrap()
+    }
+
+    /// The natural periods against the closed forms of the decoupled upright oscillators
+    /// (heave `2π √(mv/(g ρ A_wp))`, roll `2π √(T1/(mv g GM_T))`, pitch `2π √(T2/(mv g GM_L))`),
+    /// written from the vessel file's numbers, not from the components.
+    #[test]
+    fn natural_periods_match_the_closed_forms() {
+        let v = Vessel::paper();
+        let sys = VesselSystem::new(&v, Some(0.0));
+        let (m, g) = (scalar(&v, "mass"), scalar(&v, "gravity"));
+        let t = param(&v, "vessel", "inertia");
+        let tau = 2.0 * std::f64::consts::PI;
+        let heave = tau * (m / (g * scalar(&v, "water_density") * scalar(&v, "waterplane_area"))).sqrt();
+        let roll = tau * (t.x / (m * g * scalar(&v, "gm_transverse"))).sqrt();
+        let pitch = tau * (t.y / (m * g * scalar(&v, "gm_longitudinal"))).sqrt();
+        let mut want = vec![heave, roll, pitch];
+        want.sort_by(|a, b| a.total_cmp(b));
+        let got = sys.natural_periods(&Matrix3::identity(), false);
+        assert_eq!(got.len(), 3, "{got:?}");
+        for (a, b) in got.iter().zip(&want) {
+            assert!((a - b).abs() <= 1e-9 * b, "{got:?} vs {want:?}");
+        }
+        assert!((pitch - 4.079).abs() < 1e-3 && (heave - 4.249).abs() < 1e-3 && (roll - 9.21).abs() < 1e-2);
+        // The controller adds the surge, sway and yaw loops (strongly damped: no faster mode).
+        let on = sys.natural_periods(&Matrix3::identity(), true);
+        assert!(on.len() >= 3 && (on[0] - pitch).abs() <= 1e-9 * pitch, "{on:?}");
     }
 
     fn random_state(v: &Vessel, seed: [f64; 8]) -> VesselState {
