@@ -177,6 +177,7 @@ CATALOGUE: list[Bad] = [
     Bad("unknown initial-state field", sim(initial={"speed": [1.0, 0.0, 0.0]}), E, ("speed", "allowed")),
     Bad("flat initial state of the wrong length", sim(initial=np.zeros(26)), E, ("27", "got 26")),
     Bad("NaN in the initial state", initial_with(18, math.nan), E, ("initial state", "finite", "entry 18 (x)")),
+    Bad("restoring state with a yaw component", initial_with(17, 1e6), E, ("entry 17", "mu[2]", "must be 0")),
     Bad("flat initial state given as a matrix", sim(initial=np.zeros((3, 9))), E, ("1-D", "(3, 9)")),
     Bad("reflection as initial attitude, projected", lambda: phsplit.simulate(
         phsplit.Vessel.paper(), (0.0, 1.0), 0.5, initial=_reflected(), orthonormalize=True), E, ("det Q", "reflection")),

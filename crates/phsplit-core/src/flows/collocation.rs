@@ -145,7 +145,8 @@ where
 /// An affine system in 3-blocks with the structure of the vessel's flow S2 (paper eq. 41),
 /// state `z = (u, v, w)`:
 /// `u' = A_uu u + A_uv v + A_uw w + c_u`, `v' = A_vu u`, `w' = A_wv v + c_w`.
-/// Translation: `(p, x − x_ref, phi_x)`; rotation: `(m, mu, phi_th)`.
+/// Translation: `(p, x − x_o, phi_x)` (`x_o` the controller's set point `x_ref` when there is
+/// a controller, else 0); rotation: `(m, mu, phi_th)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Blocks {
     pub auu: Matrix3<f64>,

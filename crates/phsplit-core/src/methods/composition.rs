@@ -19,7 +19,8 @@ pub enum Flow {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Outer {
     /// The dissipative flow S2 is outermost. This is the default: for SP4 it is the
-    /// arrangement with the weaker Prop. 2.5 condition (`σmax/σmin ≤ 12.9` instead of 4.48).
+    /// arrangement with the weaker Prop. 2.5 condition (`σmax/σmin ≤ 12.9` instead of 4.48);
+    /// for SP6 it is the other way round (1.91 instead of 4.36; docs/model.md §1.5).
     #[default]
     Dissipative,
     /// The conservative flow S1 is outermost.
@@ -67,7 +68,8 @@ pub struct Composition {
     pub name: &'static str,
     /// Classical order.
     pub order: usize,
-    /// Number of evaluations of the inner flow `B` per step.
+    /// Number of sub-steps `2m` of format (10) per step, before adjacent sub-steps of one
+    /// flow are merged (the paper's count; Strang: 2, of which merging leaves one `B` flow).
     pub stages: usize,
     /// Where the coefficients come from.
     pub citation: &'static str,

@@ -96,6 +96,15 @@ impl VesselState {
                 y[i]
             )));
         }
+        if y[17] != 0.0 {
+            // G = diag(·, ·, 0): mu_3 has no store in H and no account in the ledger, so a
+            // nonzero value would exert a moment the energy balance cannot see (docs/model.md
+            // §2.3, §6 N6). Every run keeps it exactly 0 (its rate is G_33 (...) = 0).
+            return Err(Error::InvalidInput(format!(
+                "the initial state's entry 17 (mu[2], the yaw component of the restoring state) must be 0 (the restoring matrix G has no yaw entry), got {}",
+                y[17]
+            )));
+        }
         let mut s = Self::from_vector(&SVector::<f64, STATE_DIM>::from_column_slice(y));
         let (defect, det) = (so3::orthogonality_defect(&s.q), s.q.determinant());
         if orthonormalize {

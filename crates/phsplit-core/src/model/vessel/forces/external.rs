@@ -1,4 +1,4 @@
-//! A constant external force and moment at a point of the hull: the `X` of the seed's
+//! A constant external force and moment at a point of the hull: the `X` of the paper's
 //! eq. (1), `M ν' + C(ν)ν + D(ν)ν + g(η) = τ + X + w` (docs/model.md §5).
 //!
 //! Table `[external]` (optional): `force` (N) and `moment` (N m), given in the body frame
