@@ -45,9 +45,10 @@ def order_reference():
     return end, floor
 
 
+@pytest.mark.parametrize("project", [False, True], ids=["paper", "projected"])
 @pytest.mark.parametrize("linear_flow", ["exact", "gauss"])
 @pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4), ("sp6", 6)])
-def test_order_of_the_splitting_methods(method, order, linear_flow, order_reference):
+def test_order_of_the_splitting_methods(method, order, linear_flow, project, order_reference):
     """Paper Fig. 3: t in [0, 1], h = 2^-k, relative end-point errors of m, q, p, x; the fitted
     log-log slope is the order within 0.2.
 
@@ -57,13 +58,20 @@ def test_order_of_the_splitting_methods(method, order, linear_flow, order_refere
     the single step at h = 1 is pre-asymptotic for some variables. A method of the wrong order
     forms no such run. The run must have at least four points; the slope is fitted on its three
     finest, leaving out the very finest when the run has five or more (it is the point nearest
-    round-off)."""
+    round-off).
+
+    "paper": the scheme as printed. "projected": with the projection onto the restoring
+    invariant after every step (the default; docs/model.md §3.6). A projection onto an invariant
+    manifold of the exact flow keeps the order (Hairer–Lubich–Wanner §IV.4) but changes the error
+    constants: it removes the part of the order-p error that the invariant's drift feeds into p
+    and x, so over these steps their slopes can lie above p. For it the test asserts order at
+    least p (slope ≥ p − 0.2) and at most p + 1."""
     end, floor = order_reference
     hs, errs = [], {k: [] for k in ("m", "q", "p", "x")}
     for k in range(0, 9):
         h = 2.0**-k
         s = phsplit.simulate(VESSEL, (0.0, 1.0), h, method, control_start=0.0, ledger=False,
-                             linear_flow=linear_flow)
+                             linear_flow=linear_flow, project_invariants=project)
         hs.append(h)
         errs["m"].append(rel(s.m[-1], end["m"]))
         errs["p"].append(rel(s.p[-1], end["p"]))
@@ -88,7 +96,10 @@ def test_order_of_the_splitting_methods(method, order, linear_flow, order_refere
         slope = fit_slope(hs[hi - 3:hi], e[hi - 3:hi])
         n = hi
         print(f"{method} {var}: slope {slope:.3f} over k = {n - 3}..{n - 1}; local slopes {np.round(local, 2)}")
-        assert abs(slope - order) <= 0.2, f"{method} {var}: slope {slope:.3f}, local {local}, errors {e[:n]}"
+        if project:
+            assert order - 0.2 <= slope <= order + 1.0, f"{method} {var}: slope {slope:.3f}, local {local}, errors {e[:n]}"
+        else:
+            assert abs(slope - order) <= 0.2, f"{method} {var}: slope {slope:.3f}, local {local}, errors {e[:n]}"
 
 
 def test_fig2_scenario_end_state():

@@ -62,19 +62,29 @@ def test_orders_with_the_load_against_the_independent_model(method, order):
     y0 = v.initial_state()
     _, y = ref.solve(v.to_dict(), y0, 2.0, 0.0, rtol=1e-13)
     xe, pe = y[-1][18:21], y[-1][0:3]
-    hs, errs = [], []
-    for k in range(1, 6):
-        h = 2.0 ** -k
-        s = phsplit.simulate(v, (0.0, 2.0), h, method, control_start=0.0, ledger=False)
-        hs.append(h)
-        errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
-    errs = np.array(errs)
-    keep = errs > 1e-12
-    slope = np.polyfit(np.log(np.array(hs)[keep]), np.log(errs[keep]), 1)[0]
-    assert abs(slope - order) < 0.2, (slope, errs)
-    # and the finest run agrees with the reference position to well within a millimetre
-    s = phsplit.simulate(v, (0.0, 2.0), 2.0**-5, method, control_start=0.0, ledger=False)
+    for project in (False, True):
+        hs, errs = [], []
+        for k in range(1, 6):
+            h = 2.0 ** -k
+            s = phsplit.simulate(v, (0.0, 2.0), h, method, control_start=0.0, ledger=False,
+                                 project_invariants=project)
+            hs.append(h)
+            errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
+        errs = np.array(errs)
+        keep = errs > 1e-12
+        slope = np.polyfit(np.log(np.array(hs)[keep]), np.log(errs[keep]), 1)[0]
+        if project:  # order kept, error constants changed: see test_acceptance's order test
+            assert order - 0.2 <= slope <= order + 1.0, (slope, errs)
+        else:
+            assert abs(slope - order) < 0.2, (slope, errs)
+    # and the finest run agrees with the reference position to well within a millimetre: the
+    # paper's scheme to 1e-6 m; with the projection onto the restoring invariant (the default),
+    # whose error constant in x is larger on short runs (docs/model.md §3.6), to 1e-5 m
+    s = phsplit.simulate(v, (0.0, 2.0), 2.0**-5, method, control_start=0.0, ledger=False,
+                         project_invariants=False)
     assert np.linalg.norm(s.x[-1] - xe) < 1e-6
+    s = phsplit.simulate(v, (0.0, 2.0), 2.0**-5, method, control_start=0.0, ledger=False)
+    assert np.linalg.norm(s.x[-1] - xe) < 1e-5
 
 
 def test_the_controller_holds_position_against_a_constant_force():

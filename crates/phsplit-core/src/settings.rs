@@ -24,6 +24,9 @@ pub struct Settings {
     pub linear_flow: LinearFlow,
     /// Keep the energy ledger.
     pub ledger: bool,
+    /// Project after every step onto the invariants of the exact flow that the split does not
+    /// keep (the restoring invariant; docs/model.md §3.6). Energy-neutral.
+    pub project_invariants: bool,
 }
 
 impl Default for Settings {
@@ -39,12 +42,13 @@ impl Default for Settings {
             save_every: 1,
             linear_flow: LinearFlow::Exact,
             ledger: true,
+            project_invariants: true,
         }
     }
 }
 
 /// The keys of a `[simulation]` table, with what each takes.
-pub const KEYS: [(&str, &str); 9] = [
+pub const KEYS: [(&str, &str); 10] = [
     ("t_span", "two numbers [t0, t1], s"),
     ("h", "step size, s"),
     ("method", "a method name"),
@@ -53,6 +57,7 @@ pub const KEYS: [(&str, &str); 9] = [
     ("save_every", "an integer >= 1"),
     ("linear_flow", "'exact' or 'gauss'"),
     ("ledger", "true or false"),
+    ("project_invariants", "true or false"),
     ("name", "a label for the output files"),
 ];
 
@@ -140,6 +145,13 @@ impl Settings {
                 "ledger" => {
                     s.ledger = v.as_bool().ok_or_else(|| {
                         Error::Parse(format!("simulation.ledger must be true or false, got {v}"))
+                    })?
+                }
+                "project_invariants" => {
+                    s.project_invariants = v.as_bool().ok_or_else(|| {
+                        Error::Parse(format!(
+                            "simulation.project_invariants must be true or false, got {v}"
+                        ))
                     })?
                 }
                 "name" => name = Some(check_name(string(key, v)?)?),

@@ -279,6 +279,7 @@ fn settings_dict<'py>(py: Python<'py>, s: &Settings, name: Option<String>) -> Py
     d.set_item("save_every", s.save_every)?;
     d.set_item("linear_flow", s.linear_flow.name())?;
     d.set_item("ledger", s.ledger)?;
+    d.set_item("project_invariants", s.project_invariants)?;
     let steps = s.steps().ok();
     d.set_item("n_steps", steps.map(|x| x.0))?;
     d.set_item("last_h", steps.map(|x| x.1))?;
@@ -396,7 +397,9 @@ fn integrate<'py>(
     let out = py
         .detach(move || {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                let sys = VesselSystem::new(&v, s2.control_start).with_linear_flow(s2.linear_flow);
+                let sys = VesselSystem::new(&v, s2.control_start)
+                    .with_linear_flow(s2.linear_flow)
+                    .with_projection(s2.project_invariants);
                 let traj = run_watched(&sys, &s2.method, y0, &opts, mon)?;
                 // The force and moment of each account at the saved states.
                 let wrenches: Vec<_> = traj

@@ -344,6 +344,7 @@ class Settings:
     save_every: int = _DEFAULTS["save_every"]
     linear_flow: str = _DEFAULTS["linear_flow"]
     ledger: bool = _DEFAULTS["ledger"]
+    project_invariants: bool = _DEFAULTS["project_invariants"]
 
     def as_core(self) -> dict[str, Any]:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
@@ -369,6 +370,7 @@ def simulate(
     outer: str = Settings.outer,
     save_every: int = Settings.save_every,
     ledger: bool = Settings.ledger,
+    project_invariants: bool = Settings.project_invariants,
     initial: np.ndarray | Mapping[str, Sequence[float]] | None = None,
     linear_flow: str = Settings.linear_flow,
     orthonormalize: bool = False,
@@ -382,8 +384,11 @@ def simulate(
     acts from the first step that starts at or after ``control_start`` (``None``: never).
     ``outer`` chooses the outermost flow of a splitting: ``"dissipative"`` (S2, default) or
     ``"conservative"`` (S1). The run takes ``ceil((t1 - t0) / h)`` steps (to round-off), the
-    last one shorter when the span is not a whole number of steps, and saves every ``save_every``-th step and the last. ``initial`` overrides the vessel's initial
-    state: a flat 27-vector or a mapping with ``euler``, ``position``, ``velocity``,
+    last one shorter when the span is not a whole number of steps, and saves every
+    ``save_every``-th step and the last. ``project_invariants`` (default on) turns the attitude
+    after every step so that the restoring invariant ``mu = G Q^T e3`` of the exact flow holds
+    again; it changes no energy (docs/model.md §3.6); ``False`` runs the paper's scheme as
+    printed. ``initial`` overrides the vessel's initial state: a flat 27-vector or a mapping with ``euler``, ``position``, ``velocity``,
     ``angular_velocity``. ``linear_flow`` integrates the linear flow S2 exactly (``"exact"``,
     matrix exponentials) or by Gauss collocation of the method's order (``"gauss"``, the
     diagonal Padé approximant: faster, same order, still passive; paper Remark 2.3). An initial
@@ -406,7 +411,8 @@ def simulate(
         raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
     if settings is None:
         settings = Settings(t_span=t_span, h=h, method=method, control_start=control_start, outer=outer,
-                            save_every=save_every, linear_flow=linear_flow, ledger=ledger)
+                            save_every=save_every, linear_flow=linear_flow, ledger=ledger,
+                            project_invariants=project_invariants)
     if isinstance(settings.save_every, float):
         raise _core.InvalidInputError(f"save_every must be an integer >= 1, got {settings.save_every!r}")
     if initial is None:

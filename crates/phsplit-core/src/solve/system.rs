@@ -67,6 +67,18 @@ pub trait Model {
     fn same_field(&self, t_a: f64, t_b: f64) -> bool;
     /// The ledger's accounts (at most [`MAX_ACCOUNTS`]); [`Work`] values follow this order.
     fn accounts(&self) -> &[Account];
+    /// Whether the kernels call [`Model::project`] after every step. Sub-steps are then not
+    /// merged across step boundaries (the state must exist there to be projected).
+    fn projects(&self) -> bool {
+        false
+    }
+    /// Project `s`, after a step, onto an invariant manifold of the model's exact flow that the
+    /// method does not keep (standard projection, Hairer–Lubich–Wanner, *Geometric Numerical
+    /// Integration*, §IV.4: it keeps the method's order). Returns the energy the projection
+    /// adds, per account; a projection that leaves the energy unchanged returns zero.
+    fn project(&self, _s: &mut Self::State) -> Work {
+        Work::default()
+    }
 }
 
 /// Which of the two flows of a split model a sub-step belongs to.

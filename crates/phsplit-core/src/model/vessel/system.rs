@@ -72,6 +72,9 @@ pub struct VesselSystem<'a> {
     bases: Vec<usize>,
     /// Origin of the translational block (the controller's set point, if any).
     origin: Vector3<f64>,
+    /// Project after every step onto the invariants the split does not keep (the restoring
+    /// invariant `mu = G Qᵀe3`; [`Force::project`]).
+    pub project: bool,
 }
 
 impl<'a> VesselSystem<'a> {
@@ -99,7 +102,15 @@ impl<'a> VesselSystem<'a> {
             accounts,
             bases,
             origin,
+            project: true,
         }
+    }
+
+    /// The same system with (`true`, the default) or without (the paper's scheme as printed)
+    /// the projection after every step ([`Force::project`], docs/model.md §3.6).
+    pub fn with_projection(mut self, project: bool) -> Self {
+        self.project = project;
+        self
     }
 
     /// The same system with flow S2 integrated by `linear`.
@@ -419,6 +430,15 @@ impl Model for VesselSystem<'_> {
     }
     fn accounts(&self) -> &[Account] {
         &self.accounts
+    }
+    fn projects(&self) -> bool {
+        self.project
+    }
+    fn project(&self, s: &mut VesselState) -> Work {
+        for f in &self.vessel.forces {
+            f.project(s);
+        }
+        Work::default()
     }
 }
 

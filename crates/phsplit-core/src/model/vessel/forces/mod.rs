@@ -170,6 +170,10 @@ pub trait Force: Debug + Send + Sync {
     }
     /// Set the state variables it owns from the rest of the state (a consistent start).
     fn init_state(&self, _s: &mut VesselState) {}
+    /// Restore, after a step, an invariant of the exact flow that involves the component's own
+    /// state and that the splitting does not keep ([`crate::solve::Model::project`]). It must
+    /// leave H unchanged (it books nothing), which its tests check.
+    fn project(&self, _s: &mut VesselState) {}
     /// A position it prefers as the origin of the translational block (the controller's set
     /// point): quadratic forms in `x − x_o` then carry no large terms that cancel.
     fn position_origin(&self) -> Option<Vector3<f64>> {

@@ -70,4 +70,31 @@ impl Force for Restoring {
     fn init_state(&self, s: &mut VesselState) {
         s.mu = self.g.component_mul(&(s.q.transpose() * Vector3::z()));
     }
+    /// The invariant `c = mu − G Qᵀe3` (zero from a consistent start) is kept by the exact flow
+    /// and by every Runge–Kutta method (it is linear in the Runge–Kutta variables), but not by
+    /// the split: S1 turns `Q` without `mu`, S2 moves `mu` at frozen `Q`. Its drift leaves the
+    /// vessel at rest with a false heel and trim (docs/model.md §3.6). The projection turns the
+    /// attitude by the smallest rotation `E` that gives `G Qᵀe3 = mu` again (`Q ← Q E`, `E t =
+    /// q3` with `t = (mu₁/G₁, mu₂/G₂, ±√(1 − ·))`), and leaves `mu` alone: H does not depend on
+    /// `Q`, so the projection neither creates nor removes energy and the ledger books nothing.
+    /// Beyond 90° of heel (no such `t`) it does nothing.
+    fn project(&self, s: &mut VesselState) {
+        let (g0, g1) = (self.g.x, self.g.y);
+        if !(g0 > 0.0 && g1 > 0.0) {
+            return;
+        }
+        let q3 = s.q.transpose() * Vector3::z();
+        let (t0, t1) = (s.mu.x / g0, s.mu.y / g1);
+        let r2 = t0 * t0 + t1 * t1;
+        if !(r2 < 1.0) {
+            return;
+        }
+        let t = Vector3::new(t0, t1, (1.0 - r2).sqrt().copysign(q3.z));
+        let axis = t.cross(&q3);
+        let sin = axis.norm();
+        if sin == 0.0 {
+            return;
+        }
+        s.q *= so3::exp(&(axis * (sin.atan2(t.dot(&q3)) / sin)));
+    }
 }
