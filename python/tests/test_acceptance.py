@@ -47,7 +47,7 @@ def order_reference():
 
 @pytest.mark.parametrize("project", [False, True], ids=["paper", "projected"])
 @pytest.mark.parametrize("linear_flow", ["exact", "gauss"])
-@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4), ("sp6", 6)])
+@pytest.mark.parametrize("method,order", [("sp2", 2), ("mcl2", 2), ("sp4", 4), ("sp6", 6)])
 def test_order_of_the_splitting_methods(method, order, linear_flow, project, order_reference):
     """Paper Fig. 3: t in [0, 1], h = 2^-k, relative end-point errors of m, q, p, x; the fitted
     log-log slope is the order within 0.2.

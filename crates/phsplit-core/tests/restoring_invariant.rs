@@ -43,15 +43,17 @@ fn invariant(v: &Vessel, s: &VesselState) -> Vector3<f64> {
 fn at_rest_the_vessel_is_upright_for_every_method_and_step() {
     let v = Vessel::paper();
     // (method, steps): every registered method at steps where it is stable on this vessel.
-    let cases: [(&str, &[f64]); 7] = [
+    let cases: [(&str, &[f64]); 8] = [
         ("lie", &[0.25, 1.0, 4.0]),
         ("sp2", &[0.2, 1.0, 4.0]),
+        ("mcl2", &[0.25, 1.0, 4.0]),
         ("sp4", &[0.5, 2.0]),
         ("sp6", &[0.5, 1.0]),
         ("rk4", &[0.25, 1.0]),
         ("heun", &[0.25]),
         ("euler", &[0.01]), // at 0.05 s its growth factor nearly cancels the roll damping: not at rest by 3600 s
     ];
+    assert_eq!(cases.len(), phsplit_core::methods::REGISTRY.len(), "every registered method");
     for (method, hs) in cases {
         for &h in hs {
             let (mid, end) = final_state(method, h, 3600.0, true);

@@ -131,6 +131,25 @@ impl Composition {
         )
     }
 
+    /// McLachlan's two-stage method of order 2,
+    /// `A(λh) B(h/2) A((1 − 2λ)h) B(h/2) A(λh)`, with the `λ` that minimises the norm of its
+    /// leading error terms among such methods, in closed form `λ = 1/2 − s/12 + 1/(6s)`,
+    /// `s = (36 + 2√326)^{1/3}`, `λ = 0.19318332750378…`
+    /// (McLachlan, SIAM J. Sci. Comput. 16 (1995) 151–168; the same coefficient as the
+    /// "minimum-norm" 2MN integrator of Omelyan, Mryglod & Folk, Comput. Phys. Commun. 146
+    /// (2002) 188–202). All sub-steps positive: passive for any step (Prop. 2.2).
+    pub fn mclachlan_2() -> Self {
+        let s = (36.0 + 2.0 * 326f64.sqrt()).cbrt();
+        let lambda = 0.5 - s / 12.0 + 1.0 / (6.0 * s);
+        Self::symmetric(
+            "mcl2",
+            2,
+            "McLachlan, SIAM J. Sci. Comput. 16 (1995) 151–168 (two stages, minimal error norm)",
+            &[lambda, 1.0 - 2.0 * lambda],
+            &[0.5],
+        )
+    }
+
     /// Blanes & Moan (2002), order 4, 6 stages (paper §2; docs/model.md §1).
     pub fn blanes_moan_4() -> Self {
         let (a1, a2, a3) = (

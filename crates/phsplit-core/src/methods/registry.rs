@@ -41,6 +41,12 @@ pub const REGISTRY: &[Entry] = &[
         build: || Method::Splitting(Composition::strang()),
     },
     Entry {
+        name: "mcl2",
+        aliases: &["mclachlan2"],
+        summary: "McLachlan's 2-stage order-2 splitting, minimal error norm, positive steps",
+        build: || Method::Splitting(Composition::mclachlan_2()),
+    },
+    Entry {
         name: "sp4",
         aliases: &[],
         summary: "Blanes–Moan splitting, 6 stages",
@@ -161,6 +167,7 @@ mod tests {
         for c in [
             Composition::lie(),
             Composition::strang(),
+            Composition::mclachlan_2(),
             Composition::blanes_moan_4(),
             Composition::blanes_moan_6(),
         ] {
@@ -188,12 +195,23 @@ mod tests {
     fn symmetric_methods_are_palindromes() {
         for c in [
             Composition::strang(),
+            Composition::mclachlan_2(),
             Composition::blanes_moan_4(),
             Composition::blanes_moan_6(),
         ] {
             let rev: Vec<_> = c.substeps.iter().rev().cloned().collect();
             assert_eq!(rev, c.substeps, "{}", c.name);
         }
+    }
+
+    #[test]
+    fn mclachlans_coefficient_is_the_published_one() {
+        // λ = 0.1931833275037836 as printed by Omelyan, Mryglod & Folk (2002) and
+        // used for McLachlan's method; the closed form in the code must give it to round-off.
+        let c = Composition::mclachlan_2();
+        assert!((c.substeps[0].1 - 0.193_183_327_503_783_6).abs() < 4.0 * f64::EPSILON);
+        assert_eq!(c.substeps.len(), 5);
+        assert!(c.all_positive() && c.dissipation_ratio_bound(true) == f64::INFINITY);
     }
 
     #[test]
