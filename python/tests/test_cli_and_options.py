@@ -18,7 +18,7 @@ def test_default_simulate_writes_netcdf_and_png(tmp_path, capsys):
     nc, png = tmp_path / "fig2.nc", tmp_path / "fig2.png"
     assert nc.stat().st_size > 10_000 and png.stat().st_size > 10_000
     assert str(nc) in out and str(png) in out
-    with xr.open_dataset(nc) as ds:
+    with phsplit.open_dataset(nc) as ds:
         assert ds.sizes["time"] == 401
         assert ds.attrs["method"] == "sp4"
         assert abs(float(ds["position"][-1, 0]) - 780.0) < 1.5
@@ -29,7 +29,7 @@ def test_scenario_file_runs_instead(tmp_path):
     sc = tmp_path / "short.toml"
     sc.write_text('[simulation]\nt_span = [0.0, 20.0]\nh = 0.25\nmethod = "sp2"\ncontrol_start = 5.0\n')
     assert main(["simulate", str(sc), "--out", str(tmp_path), "--no-plot"]) == 0
-    with xr.open_dataset(tmp_path / "short.nc") as ds:
+    with phsplit.open_dataset(tmp_path / "short.nc") as ds:
         assert ds.sizes["time"] == 81 and ds.attrs["method"] == "sp2"
 
 
@@ -144,7 +144,7 @@ def test_vector_field_binding_matches_the_independent_model():
 def test_chunked_cli_output_equals_one_simulate_call(tmp_path):
     assert main(["simulate", "--out", str(tmp_path), "--no-plot", "--save-every", "3"]) == 0
     s = phsplit.simulate(phsplit.Vessel.paper(), save_every=3)
-    with xr.open_dataset(tmp_path / "fig2-s3.nc") as ds:  # the command-line option is in the name
+    with phsplit.open_dataset(tmp_path / "fig2-s3.nc") as ds:  # the command-line option is in the name
         np.testing.assert_array_equal(ds["time"].values, s.t)
         np.testing.assert_array_equal(ds["position"].values, s.x)
         np.testing.assert_array_equal(ds["energy_dissipated"].values, s.ledger.dissipated)
@@ -171,7 +171,7 @@ def test_sigterm_during_simulate_leaves_a_valid_file_with_the_steps_so_far(tmp_p
     assert p.returncode == 130, err
     assert "interrupted after" in err
     assert not parts()
-    with xr.open_dataset(tmp_path / f"{name}.nc") as ds:
+    with phsplit.open_dataset(tmp_path / f"{name}.nc") as ds:
         assert ds.attrs["status"] == "interrupted"
         n = ds.sizes["time"]
         assert 1 < n < 400000 / 0.05 / 200 + 1

@@ -110,7 +110,7 @@ def test_scenario_file_and_cli(tmp_path, capsys):
     assert main(["simulate", str(sc), "--out", str(tmp_path), "--no-plot"]) == 0
     out = capsys.readouterr().out
     assert "external" in out and "components: damping, restoring, pid, external" in out
-    with xr.open_dataset(tmp_path / "pushed.nc") as ds:
+    with phsplit.open_dataset(tmp_path / "pushed.nc") as ds:
         assert "energy_external" in ds and "force_external" in ds
         direct = phsplit.simulate(loaded_sc.vessel, settings=loaded_sc.settings)
         np.testing.assert_array_equal(ds["position"].values, direct.x)

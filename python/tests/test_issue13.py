@@ -119,7 +119,7 @@ def test_no_cli_input_gives_a_traceback_a_stray_file_or_a_corrupt_one(tmp_path_f
     for f in work.rglob("*"):
         assert not f.name.endswith(".part"), (argv, f)
         if f.suffix == ".nc":
-            with xr.open_dataset(f) as ds:
+            with phsplit.open_dataset(f) as ds:
                 assert ds.attrs["status"] in ("completed", "failed") and ds.sizes["time"] >= 1
 
 
@@ -140,7 +140,7 @@ def _check_output(out, code, err):
     if not nc.exists():
         assert "no file was written" in err or "no partial output" in err, err
         return 0
-    with xr.open_dataset(nc) as ds:
+    with phsplit.open_dataset(nc) as ds:
         assert ds.attrs["status"] in ("interrupted", "completed")
         t = ds["time"].values
         assert np.all(np.diff(t) > 0) and t[0] == 0.0
@@ -196,7 +196,7 @@ def test_a_second_writer_of_the_same_output_is_refused_and_the_first_file_is_val
     files = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
     assert files == ["fig2-sp2-h0.02-t300-gauss.nc"]
     assert not list(tmp_path.glob("*.part")) and not list(tmp_path.glob(".*.part"))
-    with xr.open_dataset(tmp_path / files[0]) as ds:
+    with phsplit.open_dataset(tmp_path / files[0]) as ds:
         assert ds.attrs["status"] == "completed" and float(ds["time"][-1]) == 300.0
     # and once the first is done, the same command runs again
     assert subprocess.run(args, capture_output=True, text=True, timeout=300).returncode == 0
@@ -207,7 +207,7 @@ def test_runs_with_different_options_do_not_overwrite_each_other(tmp_path):
         assert main(["simulate", "--out", str(tmp_path), "--no-plot", "--method", m, "--t-end", "10"]) == 0
     names = sorted(p.name for p in tmp_path.glob("*.nc"))
     assert names == ["fig2-rk4-t10.nc", "fig2-sp2-t10.nc"]
-    with xr.open_dataset(tmp_path / names[0]) as a, xr.open_dataset(tmp_path / names[1]) as b:
+    with phsplit.open_dataset(tmp_path / names[0]) as a, phsplit.open_dataset(tmp_path / names[1]) as b:
         assert a.attrs["method"] == "rk4" and b.attrs["method"] == "sp2"
 
 
@@ -275,5 +275,5 @@ def test_one_default_for_the_controller_start_everywhere(tmp_path):
     assert phsplit.load_scenario(str(f)).control_start == default
     assert main(["simulate", str(f), "--out", str(tmp_path), "--no-plot", "--t-end", "1",
                  "--control-start", "never"]) == 0
-    with xr.open_dataset(tmp_path / "empty-t1-cnever.nc") as ds:
+    with phsplit.open_dataset(tmp_path / "empty-t1-cnever.nc") as ds:
         assert "never" in str(ds.attrs.get("control_start", "never"))

@@ -13,6 +13,8 @@ import matplotlib.image as mpimg
 import pytest
 import xarray as xr
 
+import phsplit
+
 FILES = {
     "fig2": ((660, 1320), {"position", "euler", "energy", "energy_supplied", "energy_dissipated"}),
     "fig3": ((880, 1100), {"relative_error", "fitted_order", "reference_accuracy"}),
@@ -51,8 +53,16 @@ def test_figures_have_the_expected_size(quick_run):
 def test_netcdf_files_hold_the_data(quick_run):
     out, _ = quick_run
     for name, (_, variables) in FILES.items():
-        with xr.open_dataset(out / f"{name}.nc") as ds:
+        with phsplit.open_dataset(out / f"{name}.nc") as ds:
             assert variables <= set(ds.data_vars), (name, set(ds.data_vars))
+
+
+def test_netcdf_files_are_cf_compliant(quick_run):
+    from test_results import cf_problems
+
+    out, _ = quick_run
+    for name in FILES:
+        assert cf_problems(out / f"{name}.nc") == [], name
 
 
 def test_report_orders_and_claims(quick_run):

@@ -66,7 +66,7 @@ def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
     sw = load_sweep(str(f))
     ids = {sw.case_id(i) for i in range(9)}
     assert done_cases(str(store)) == ids
-    with xr.open_dataset(store / "summary.nc") as s:
+    with phsplit.open_dataset(store / "summary.nc") as s:
         status = list(s["status"].values)
     assert status.count("invalid") == 3 and status.count("completed") == 6
     # a second run reuses everything
@@ -112,7 +112,7 @@ def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
     ids = [sw.case_id(i) for i in range(12)]
     files = sorted(os.listdir(store / "cases"))
     assert files == sorted(f"{i}.nc" for i in ids)  # every case exactly once, no temporary files
-    with xr.open_dataset(store / "summary.nc") as s:
+    with phsplit.open_dataset(store / "summary.nc") as s:
         assert list(s["status"].values) == ["completed"] * 12
 
 
@@ -154,7 +154,7 @@ def test_a_sweep_rerun_with_other_settings_recomputes_every_case(tmp_path):
     res = run_sweep(sw, str(store), n_workers=1, progress=False)
     assert res["computed"] == 3 and res["reused"] == 0
     for i in range(3):
-        with xr.open_dataset(store / "cases" / f"{sw.case_id(i)}.nc") as ds:
+        with phsplit.open_dataset(store / "cases" / f"{sw.case_id(i)}.nc") as ds:
             assert float(ds["time"][-1]) == 20.0
     import json
 

@@ -166,6 +166,11 @@ impl PyVessel {
             inner: Vessel::from_table(to_table(d, "")?).map_err(to_py)?,
         })
     }
+    /// Every parameter as read, as TOML text (the `toml` crate's writer; floats in their
+    /// shortest round-trip form, so `from_toml_str(to_toml())` rebuilds the vessel exactly).
+    fn to_toml(&self) -> PyResult<String> {
+        toml::to_string(&self.inner.params).map_err(|e| PhsplitError::new_err(format!("cannot write TOML: {e}")))
+    }
     /// The TOML text of the paper's vessel, with its provenance.
     #[staticmethod]
     fn paper_toml() -> &'static str {
@@ -302,6 +307,14 @@ fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 fn check_settings<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, api: bool) -> PyResult<Bound<'py, PyDict>> {
     let (s, name) = settings_of(d, api)?;
     settings_dict(py, &s, name)
+}
+
+/// A mapping of TOML values (tables of numbers, strings, booleans, lists) as TOML text, by
+/// the `toml` crate's writer: phsplit's one TOML writer.
+#[pyfunction]
+fn dumps_toml(d: &Bound<'_, PyDict>) -> PyResult<String> {
+    let t = to_table(d, "")?;
+    toml::to_string(&t).map_err(|e| InvalidInputError::new_err(format!("cannot write TOML: {e}")))
 }
 
 /// The keys of a [simulation] table with what each takes.
@@ -584,6 +597,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(check_settings, m)?)?;
     m.add_function(wrap_pyfunction!(settings_keys, m)?)?;
+    m.add_function(wrap_pyfunction!(dumps_toml, m)?)?;
     m.add_function(wrap_pyfunction!(vessel_tables, m)?)?;
     m.add("METHODS", methods::names())?;
     m.add("OUTER", methods::composition::OUTER_NAMES.to_vec())?;

@@ -19,8 +19,9 @@ from ._core import (
     __version__,
 )
 from ._core import method_info as _method_info
-from . import rigid_body, so3, special
+from . import results, rigid_body, so3, special
 from .batch import simulate_many, with_parameters
+from .results import open_dataset, rerun
 from .scenario import Scenario
 from .scenario import load as load_scenario
 from .simulate import Ledger, PassivityWarning, Settings, Solution, StepSizeWarning, Vessel, simulate
@@ -47,6 +48,9 @@ __all__ = [
     "__version__",
     "load_scenario",
     "method_info",
+    "open_dataset",
+    "rerun",
+    "results",
     "rigid_body",
     "simulate",
     "simulate_many",

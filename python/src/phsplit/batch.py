@@ -33,7 +33,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from . import _core
-from .simulate import Settings, Vessel, simulate
+from .simulate import Settings, Vessel, settings_to_toml, simulate
 
 _PATH = re.compile(r"^([a-z_]+)\.([a-z_]+)(?:\[([0-9]+)\])?$")
 
@@ -142,7 +142,9 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
         },
         coords={"case": np.arange(n), "time": ("time", t, {"units": "s"}), "axis": ["x", "y", "z"],
                 "angle": ["roll", "pitch", "yaw"]},
-        attrs={"method": settings.method, "step_size_s": settings.h, "phsplit_version": _core.__version__},
+        attrs={"method": settings.method, "step_size_s": settings.h, "phsplit_version": _core.__version__,
+               "phsplit_settings": settings_to_toml(settings.checked()),
+               "phsplit_vessel": base.to_toml()},
     )
     for k in keys:
         ds = ds.assign_coords({_coord_name(k): ("case", np.array([c.get(k, np.nan) for c in cases], float),
@@ -154,7 +156,11 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
     ds["diverged"] = ("case", np.array([bool(r.get("diverged", True)) for _, r in results]))
     ds["status"] = ("case", np.array([r["status"] for _, r in results], dtype=object))
     ds["error"] = ("case", np.array([r.get("error", "") for _, r in results], dtype=object))
-    return ds
+    from .results import cf_finish
+
+    ds["time"].attrs.update({"units": "seconds since 1970-01-01 00:00:00", "standard_name": "time", "axis": "T",
+                             "long_name": "simulated time (t = 0 at the nominal epoch)"})
+    return cf_finish(ds, "phsplit simulate_many: one run per case", "simulate_many")
 
 
 # ------------------------------------------------------------------------------------------
@@ -276,8 +282,10 @@ def _write_case(store: str, cid: str, result: dict) -> None:
 
     cases_dir = os.path.join(store, "cases")
     ds = result.get("dataset")
-    if ds is None:
-        ds = xr.Dataset()
+    if ds is None:  # an invalid case: no run, only what was asked and why it was refused
+        from .results import cf_finish
+
+        ds = cf_finish(xr.Dataset(), "phsplit sweep case (not run)", "sweep")
     ds = ds.copy()
     ds.attrs.update({"case_id": cid, "case_status": result["status"], "case_error": result.get("error", ""),
                      "case_parameters": json.dumps(result["case"], sort_keys=True),
@@ -376,5 +384,8 @@ def write_summary(store: str, ids: list[str]) -> str:
             data[_coord_name(c)] = ("case", np.asarray(vals, float))
         else:
             data[_coord_name(c)] = ("case", np.asarray([str(v) for v in vals], dtype=object))
-    xr.Dataset(data).to_netcdf(os.path.join(store, "summary.nc"))
+    from .results import cf_finish
+
+    cf_finish(xr.Dataset(data), "phsplit sweep summary: one row per case", "sweep").to_netcdf(
+        os.path.join(store, "summary.nc"))
     return path

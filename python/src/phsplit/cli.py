@@ -17,6 +17,7 @@ EXAMPLES = """examples:
   phsplit reproduce --quick                # the same in a few seconds, with coarser references
   phsplit sweep gains.toml --out gains.store                # a parameter sweep on a local Dask cluster
   phsplit sweep gains.toml --scheduler tcp://10.0.0.5:8786  # ... on an existing Dask cluster
+  phsplit rerun out/fig2.nc                # rerun what a result file records, check it bit for bit
 """
 
 
@@ -71,6 +72,17 @@ def _parser() -> argparse.ArgumentParser:
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    rr = sub.add_parser(
+        "rerun",
+        help="rerun the simulation a phsplit NetCDF file records and check it bit for bit",
+        description="Read the vessel, settings, initial state and chunking recorded in FILE.nc, run "
+        "them again, and compare every variable with the file's. Exit status 0 when every number "
+        "agrees to the last bit, 1 when some differ (they are listed).",
+        epilog="examples:\n  phsplit rerun out/fig2.nc\n  phsplit rerun out/fig2.nc --out rerun/   # also write the rerun",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    rr.add_argument("file", help="a NetCDF file written by phsplit")
+    rr.add_argument("--out", help="also write the rerun as <out>/<file name>")
     w.add_argument("sweep", help="sweep TOML file ([simulation] + [sweep])")
     w.add_argument("--out", help="result store (a folder; default: <sweep name>.store)")
     w.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://host:8786")
@@ -213,25 +225,32 @@ def _simulate(args) -> int:
     fd, part = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".nc.part")  # unique per run
     os.close(fd)
     t_start = time.perf_counter()
-    state = sc.vessel.initial_state()
-    t = t0
     done = 0
     status = "completed"
     sols = []
     nc_file = None
-    from dataclasses import replace
-
     from tqdm import tqdm
+
+    from .results import run_chunks
+    from .simulate import settings_to_toml
 
     bar = tqdm(total=n, unit="step", unit_scale=True, disable=not (sys.stderr.isatty() and n > 20_000), leave=False)
     try:
         chunks = _chunks(n, sc.save_every)
-        for i, k in enumerate(chunks):
-            # The last chunk ends at t1 itself (it may close with a shorter step).
-            end = t1 if i == len(chunks) - 1 else t + k * sc.h
-            sol = phsplit.simulate(sc.vessel, initial=state, settings=replace(sc.settings, t_span=(t, end)))
+        text = None
+        if args.scenario:
+            with open(args.scenario, "rb") as f:
+                text = f.read().decode("utf-8", "replace")
+        file_attrs = {  # the whole run's, over the first chunk's (phsplit rerun reads them)
+            "phsplit_settings": settings_to_toml(sc.settings.checked()),
+            "phsplit_chunks": " ".join(map(str, chunks)),
+            "phsplit_scenario_path": args.scenario or "(built in: the paper's Fig. 2)",
+            "phsplit_scenario": text if text is not None else "",
+            "history": f"{_now()} phsplit {phsplit.__version__}: phsplit {' '.join(args.argv)}",
+        }
+        for sol in run_chunks(sc.vessel, sc.settings, sc.vessel.initial_state(), chunks):
             with _DeferSignals():
-                nc_file = _append(nc_file, part, sol, first=(done == 0), scenario=args.scenario)
+                nc_file = _append(nc_file, part, sol, first=(done == 0), attrs=file_attrs)
                 sols.append(sol)
                 done += sol.steps
                 bar.update(sol.steps)
@@ -241,8 +260,6 @@ def _simulate(args) -> int:
             if sol.status != "completed":
                 status = "failed"
                 break
-            state = sol.last_good_state
-            t = float(sol.t[-1])
     except KeyboardInterrupt:
         status = "interrupted"
     finally:
@@ -285,15 +302,21 @@ def _simulate(args) -> int:
     return 0
 
 
-def _append(nc_file, path: str, sol, first: bool, scenario):
-    """Write a chunk: the first creates the file (time unlimited), the others append their rows
-    after the first (which repeats the previous chunk's last). Synced after every chunk, so the
-    file on disk holds every finished chunk."""
+def _now() -> str:
+    import datetime
+
+    return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+
+
+def _append(nc_file, path: str, sol, first: bool, attrs: dict):
+    """Write a chunk: the first creates the file (time unlimited) with the run's ``attrs``, the
+    others append their rows after the first (which repeats the previous chunk's last). Synced
+    after every chunk, so the file on disk holds every finished chunk."""
     import netCDF4
 
     ds = sol.to_xarray()
     if first:
-        ds.attrs["scenario"] = scenario or "paper Fig. 2 (built in)"
+        ds.attrs.update(attrs)
         ds.to_netcdf(path, unlimited_dims=["time"])
         nc_file = netCDF4.Dataset(path, "a")
     else:
@@ -370,6 +393,42 @@ def _sweep(args) -> int:
     return 0
 
 
+def _rerun(args) -> int:
+    from .plotting import publish
+    from .results import compare, open_dataset, rerun
+
+    ds = open_dataset(args.file)
+    try:
+        t0 = time.perf_counter()
+        print(f"rerunning {args.file}: phsplit {ds.attrs.get('phsplit_version')} {ds.attrs.get('method')} "
+              f"h={ds.attrs.get('step_size_s')} s, {ds.sizes['time']} saved states, status "
+              f"{ds.attrs.get('status')}", flush=True)
+        again = rerun(ds)
+        diffs = compare(ds, again)
+    finally:
+        ds.close()
+    if args.out:
+        os.makedirs(args.out, exist_ok=True)
+        dest = os.path.join(args.out, os.path.basename(args.file))
+        fd, tmp = tempfile.mkstemp(dir=args.out, prefix=".rerun-", suffix=".nc")
+        os.close(fd)
+        try:
+            again.to_netcdf(tmp)
+            publish(tmp, dest)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        print(f"wrote {os.path.abspath(dest)}")
+    dt = time.perf_counter() - t0
+    if not diffs:
+        print(f"identical: every number of {len(again.data_vars)} variables agrees to the last bit ({dt:.2f} s)")
+        return 0
+    print(f"{len(diffs)} variable(s) differ:", file=sys.stderr)
+    for name, d in diffs:
+        print(f"  {name}: largest difference {d:.3e}", file=sys.stderr)
+    return 1
+
+
 def _methods() -> int:
     import phsplit
 
@@ -397,6 +456,7 @@ def main(argv: list[str] | None = None) -> int:
     warnings.showwarning = _show
     parser = _parser()
     args = parser.parse_args(argv)
+    args.argv = list(argv) if argv is not None else sys.argv[1:]
     if args.command is None:
         parser.print_help()
         return 2
@@ -409,6 +469,8 @@ def main(argv: list[str] | None = None) -> int:
             return _reproduce(args)
         if args.command == "sweep":
             return _sweep(args)
+        if args.command == "rerun":
+            return _rerun(args)
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

@@ -69,6 +69,10 @@ class Vessel:
             raise _core.InvalidInputError(f"a vessel is a mapping of tables, got {type(tables).__name__}")
         return cls(_core.Vessel.from_dict(dict(tables)), source)
 
+    def to_toml(self) -> str:
+        """Every parameter as TOML text; ``Vessel.from_toml_str`` rebuilds this vessel exactly."""
+        return self._inner.to_toml()
+
     @property
     def components(self) -> list[str]:
         """The vessel's force components (ports), in the order they are assembled."""
@@ -227,48 +231,90 @@ class Solution:
         """Body angular velocity (N, 3), rad/s."""
         return self.m / np.asarray(self.meta["inertia"])
 
+    def state(self, i: int = -1) -> np.ndarray:
+        """The flat 27-vector state at saved index ``i`` (p, m, Q column-major, mu, x, phi_th,
+        phi_x), as the core takes it."""
+        return np.concatenate([self.p[i], self.m[i], self.Q[i].reshape(-1, order="F"), self.mu[i], self.x[i],
+                               self.phi_th[i], self.phi_x[i]])
+
+    def settings_toml(self) -> str:
+        """The run's settings as a ``[simulation]`` TOML table (what a scenario file takes)."""
+        return settings_to_toml(self.settings)
+
     def to_xarray(self):
-        """The trajectory as an ``xarray.Dataset`` with named variables, units and long names."""
+        """The trajectory as a CF-1.8 ``xarray.Dataset``: every variable with ``units`` and
+        ``long_name`` (and a ``standard_name`` where CF has one), the velocities in body and
+        spatial frames, the forces and moments and the energy of every ledger account, and the
+        provenance that reruns it (``phsplit rerun``): the vessel file, the settings, the
+        initial state and the chunking of the run."""
+        import datetime as _dt
+
         import xarray as xr
 
-        ax = ["x", "y", "z"]
-        ang = ["roll", "pitch", "yaw"]
-        coords = {"time": ("time", self.t, {"units": "s", "long_name": "time"}),
-                  "axis": ax, "angle": ang, "component": ["q0", "q1", "q2", "q3"],
-                  "row": [0, 1, 2], "col": [0, 1, 2]}
+        coords = {
+            "time": ("time", self.t, {"units": "seconds since 1970-01-01 00:00:00", "calendar": "standard",
+                                      "standard_name": "time", "axis": "T",
+                                      "long_name": "simulated time (t = 0 at the nominal epoch)"}),
+            "axis_name": ("axis", np.array(["x", "y", "z"]), {"long_name": "vector component"}),
+            "angle_name": ("angle", np.array(["roll", "pitch", "yaw"]), {"long_name": "ZYX Euler angle"}),
+            "component_name": ("component", np.array(["q0", "q1", "q2", "q3"]),
+                               {"long_name": "quaternion component, scalar first"}),
+        }
 
-        def var(dims, data, units, long_name):
-            return (dims, data, {"units": units, "long_name": long_name})
+        def var(dims, data, units, long_name, **extra):
+            return (dims, np.asarray(data, dtype=np.float64), {"units": units, "long_name": long_name, **extra})
 
-        ds = xr.Dataset(
-            {
-                "position": var(("time", "axis"), self.x, "m", "spatial position x"),
-                "euler": var(("time", "angle"), self.euler, "rad", "ZYX Euler angles (roll, pitch, yaw)"),
-                "quaternion": var(("time", "component"), self.quaternion, "1", "attitude unit quaternion, scalar first"),
-                "attitude": var(("time", "row", "col"), self.Q, "1", "attitude matrix Q (body to spatial)"),
-                "linear_momentum": var(("time", "axis"), self.p, "kg m s-1", "linear momentum p, body frame"),
-                "angular_momentum": var(("time", "axis"), self.m, "kg m2 s-1", "angular momentum m, body frame"),
-                "mu": var(("time", "axis"), self.mu, "N m", "restoring-moment variable mu"),
-                "phi_theta": var(("time", "angle"), self.phi_th, "rad s", "integral of Euler-angle error"),
-                "phi_x": var(("time", "axis"), self.phi_x, "m s", "integral of position error"),
-                "energy": var(("time",), self.energy, "J", "stored energy H (eq. 35)"),
-                "energy_supplied": var(("time",), self.ledger.supplied, "J", "port work since previous sample"),
-                "energy_dissipated": var(("time",), self.ledger.dissipated, "J", "energy dissipated since previous sample"),
-                "energy_residual": var(("time",), self.ledger.residual, "J", "dH - (supplied - dissipated)"),
-                "orthogonality_defect": var(("time",), self.orthogonality_defect, "1", "||Q^T Q - I||_F"),
-            },
-            coords=coords,
-        )
+        v_body = self.v
+        v_spatial = np.einsum("nij,nj->ni", self.Q, v_body)
+        data = {
+            "position": var(("time", "axis"), self.x, "m", "position of the body origin, spatial frame (z up)"),
+            "euler": var(("time", "angle"), self.euler, "rad", "ZYX Euler angles (roll, pitch, yaw; paper eq. 21)"),
+            "quaternion": var(("time", "component"), self.quaternion, "1", "attitude unit quaternion, scalar first"),
+            "attitude": var(("time", "row", "col"), self.Q, "1", "attitude matrix Q (body to spatial)"),
+            "velocity": var(("time", "axis"), v_body, "m s-1", "linear velocity of the body origin, body frame"),
+            "velocity_spatial": var(("time", "axis"), v_spatial, "m s-1", "linear velocity, spatial frame"),
+            "angular_velocity": var(("time", "axis"), self.w, "rad s-1", "angular velocity, body frame"),
+            "linear_momentum": var(("time", "axis"), self.p, "kg m s-1", "linear momentum p, body frame"),
+            "angular_momentum": var(("time", "axis"), self.m, "kg m2 s-1", "angular momentum m, body frame"),
+            "mu": var(("time", "axis"), self.mu, "N m", "restoring-moment variable mu (docs/model.md 2.3)"),
+            "phi_theta": var(("time", "angle"), self.phi_th, "rad s", "integral of the Euler-angle error"),
+            "phi_x": var(("time", "axis"), self.phi_x, "m s", "integral of the position error"),
+            "energy": var(("time",), self.energy, "J", "stored energy H (paper eq. 35)"),
+            "energy_supplied": var(("time",), self.ledger.supplied, "J", "work supplied through the ports since the previous sample"),
+            "energy_dissipated": var(("time",), self.ledger.dissipated, "J", "energy dissipated since the previous sample"),
+            "energy_residual": var(("time",), self.ledger.residual, "J", "dH - (supplied - dissipated) since the previous sample"),
+            "orthogonality_defect": var(("time",), self.orthogonality_defect, "1", "Frobenius norm of Q^T Q - I"),
+        }
+        if self.account_force is not None and len(self.ledger.by_account):
+            data["control_force"] = var(("time", "axis"), self.control_force, "N", "controller force (P, I, D), body frame")
+            data["control_moment"] = var(("time", "axis"), self.control_moment, "N m",
+                                         "controller moment (P, I, D) about the body origin, body frame")
+        ds = xr.Dataset(data, coords=coords)
         for k, (name, series) in enumerate(self.ledger.by_account.items()):
             kind = self.ledger.kinds.get(name, "")
-            ds[f"energy_{name}"] = var(("time",), series, "J", f"energy {kind} by {name} since previous sample")
-            ds[f"force_{name}"] = var(("time", "axis"), self.account_force[:, k, :], "N",
-                                      f"force of {name}, body frame")
+            ds[f"energy_{name}"] = var(("time",), series, "J", f"energy {kind} by {name} since the previous sample")
+            ds[f"force_{name}"] = var(("time", "axis"), self.account_force[:, k, :], "N", f"force of {name}, body frame")
             ds[f"moment_{name}"] = var(("time", "axis"), self.account_moment[:, k, :], "N m",
                                        f"moment of {name} about the body origin, body frame")
+        prov = self.meta.get("provenance", {})
+        if "initial_state" in prov:
+            ds["initial_state"] = var(("state",), prov["initial_state"], "1",
+                                      "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; SI units)")
+        ds["time"].encoding["_FillValue"] = None  # CF 2.5.1: no fill value on a coordinate
+        # Time is the record (unlimited) dimension, as in the CLI's files: appendable, and the
+        # vector dimensions may then follow it (CF 2.4).
+        ds.encoding["unlimited_dims"] = {"time"}
+        now = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
         ds.attrs.update(
             {
+                "Conventions": "CF-1.8",
                 "title": "phsplit vessel simulation",
+                "institution": "phsplit",
+                "source": f"phsplit {_core.__version__} ({self.method}, h = {self.h:g} s), passivity-preserving splitting",
+                "history": f"{now} phsplit {_core.__version__}: simulated",
+                "references": "E. Celledoni, E. H. Hoiseth, N. Ramzina, Passivity-preserving splitting methods for "
+                              "rigid body systems, Multibody Syst. Dyn. 44 (2018) 251-275, arXiv:1408.2544",
+                "comment": "Model and conventions: docs/model.md of phsplit. Rerun with `phsplit rerun FILE`.",
                 "method": self.method,
                 "step_size_s": self.h,
                 "outer": str(self.settings.get("outer", "")),
@@ -278,13 +324,39 @@ class Solution:
                 "control_start_s": "none" if self.control_start is None else self.control_start,
                 "status": self.status,
                 "steps": self.steps,
-                "reference": "Celledoni, Hoiseth, Ramzina, Multibody Syst. Dyn. 44 (2018) 251-275",
                 "phsplit_version": _core.__version__,
+                "phsplit_settings": self.settings_toml(),
             }
         )
+        if "vessel_toml" in prov:
+            ds.attrs["phsplit_vessel"] = prov["vessel_toml"]
+        if "chunks" in prov:
+            ds.attrs["phsplit_chunks"] = " ".join(str(int(c)) for c in prov["chunks"])
+        ds.attrs["software"] = _software_versions()
         if self.failure:
             ds.attrs["failure"] = self.failure
         return ds
+
+
+def settings_to_toml(settings: Mapping[str, Any]) -> str:
+    """Run settings (as the core returns them) as a ``[simulation]`` TOML table."""
+    sim = {k: settings[k] for k in Settings.__dataclass_fields__ if k in settings}
+    sim["t_span"] = [float(x) for x in sim["t_span"]]
+    if sim.get("control_start") is None:
+        sim["control_start"] = "never"
+    return _core.dumps_toml({"simulation": sim})
+
+
+def _software_versions() -> str:
+    import platform
+
+    out = [f"phsplit {_core.__version__}", f"python {platform.python_version()}", f"numpy {np.__version__}"]
+    for mod in ("xarray", "netCDF4"):
+        try:
+            out.append(f"{mod} {__import__(mod).__version__}")
+        except ImportError:  # pragma: no cover - both are dependencies
+            pass
+    return ", ".join(out)
 
 
 def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray) -> None:
@@ -457,7 +529,7 @@ def simulate(
         _warn_if_energy_created(raw, info, used["outer"], e)
     body = vessel.to_dict()["vessel"]
     names = list(raw["accounts"])
-    return Solution(
+    sol = Solution(
         t=raw["t"], x=raw["x"], euler=raw["euler"], quaternion=raw["quaternion"], Q=raw["Q"],
         p=raw["p"], m=raw["m"], mu=raw["mu"], phi_th=raw["phi_th"], phi_x=raw["phi_x"],
         energy=e,
@@ -471,3 +543,7 @@ def simulate(
               "components": vessel.components},
         account_force=raw["account_force"], account_moment=raw["account_moment"], settings=dict(used),
     )
+    # What reruns it (phsplit rerun): the vessel file, the initial state the core used, one chunk.
+    sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0),
+                              "chunks": [int(used["n_steps"])]}
+    return sol
