@@ -159,3 +159,15 @@ def test_a_sweep_rerun_with_other_settings_recomputes_every_case(tmp_path):
     import json
 
     assert json.loads((store / "sweep.json").read_text())["settings"]["method"] == "rk4"
+
+
+def test_the_yaw_error_is_wrapped():
+    """Issue 14: a set point at +3.1 rad reached from the other side (-3.1 rad) is 0.083 rad away."""
+    from phsplit.batch import summarize
+
+    d = phsplit.Vessel.paper().to_dict()
+    d["control"]["euler_reference"] = [0.0, 0.0, 3.1]
+    d["initial"]["euler"] = [0.0, 0.0, -3.1]
+    v = phsplit.Vessel.from_dict(d)
+    s = phsplit.simulate(v, (0.0, 1.0), 0.5, "sp2", control_start=None)
+    assert abs(summarize(v, s)["yaw_error_rad"] - (2 * np.pi - 6.2)) < 1e-3

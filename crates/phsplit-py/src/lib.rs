@@ -38,8 +38,8 @@ create_exception!(
 create_exception!(
     _core,
     ScenarioParseError,
-    PyValueError,
-    "A parameter or scenario file that cannot be parsed (also a ValueError)."
+    InvalidInputError,
+    "A parameter or scenario file that cannot be parsed (an InvalidInputError, so also a ValueError)."
 );
 create_exception!(
     _core,

@@ -84,7 +84,8 @@ def summarize(vessel: Vessel, sol) -> dict[str, Any]:
     diverged = sol.status != "completed" or not np.all(np.isfinite(sol.energy)) or float(np.max(sol.energy)) > bound
     return {
         "position_error_m": float(np.linalg.norm(sol.x[-1] - xr_)),
-        "yaw_error_rad": float(abs(sol.euler[-1, 2] - er[2])),
+        # wrapped to [0, pi]: a heading of -3.1 rad is 0.08 rad from a set point of +3.1 rad
+        "yaw_error_rad": float(abs(math.remainder(float(sol.euler[-1, 2] - er[2]), 2.0 * math.pi))),
         "energy_final_J": float(sol.energy[-1]),
         "energy_max_J": float(np.max(sol.energy)),
         "peak_force_N": peak_t,
