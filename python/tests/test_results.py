@@ -138,3 +138,20 @@ def test_open_dataset_refuses_what_is_not_a_phsplit_file(tmp_path, bad, words):
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
         assert main(["rerun", str(tmp_path / bad)]) == 2
     assert err.getvalue().startswith("phsplit: error:") and words in err.getvalue()
+
+
+def test_plot_draws_the_dp_figure_of_a_file(cli_file, tmp_path):
+    import matplotlib.image as mpimg
+
+    path, _ = cli_file
+    png = tmp_path / "dp.png"
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(["plot", str(path), "--watch-circle", "5", "--out", str(png)]) == 0
+    img = mpimg.imread(png)
+    assert img.shape[0] > 600 and img.shape[1] > 1000 and img.std() > 0.05  # drawn, not blank
+    for args, words in ((["--watch-circle", "-1"], "--watch-circle"), (["--out", str(tmp_path / "x.txt")], ".png"),
+                        (["--out", str(tmp_path / "nowhere" / "a.png")], "does not exist")):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            assert main(["plot", str(path), *args]) == 2
+        assert words in err.getvalue() and "Traceback" not in err.getvalue()

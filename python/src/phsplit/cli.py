@@ -18,6 +18,7 @@ EXAMPLES = """examples:
   phsplit sweep gains.toml --out gains.store                # a parameter sweep on a local Dask cluster
   phsplit sweep gains.toml --scheduler tcp://10.0.0.5:8786  # ... on an existing Dask cluster
   phsplit rerun out/fig2.nc                # rerun what a result file records, check it bit for bit
+  phsplit plot out/fig2.nc --watch-circle 5  # the DP figure of a result file
 """
 
 
@@ -82,6 +83,18 @@ def _parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     rr.add_argument("file", help="a NetCDF file written by phsplit")
+    pl = sub.add_parser(
+        "plot",
+        help="draw the DP figure of a phsplit NetCDF file",
+        description="Draw the main figure of a run from its file: the horizontal track with the set point "
+        "(and a watch circle), distance and heading errors, roll, pitch and heave, the controller's force "
+        "and moment, and the energy ledger by port. Angles in degrees.",
+        epilog="examples:\n  phsplit plot out/fig2.nc\n  phsplit plot out/fig2.nc --watch-circle 5 --out fig2-dp.png",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    pl.add_argument("file", help="a NetCDF file written by phsplit")
+    pl.add_argument("--out", help="the image to write (default: FILE with .png; .pdf and .svg work too)")
+    pl.add_argument("--watch-circle", type=float, help="radius of the watch circle about the set point, m")
     rr.add_argument("--out", help="also write the rerun as <out>/<file name>")
     w.add_argument("sweep", help="sweep TOML file ([simulation] + [sweep])")
     w.add_argument("--out", help="result store (a folder; default: <sweep name>.store)")
@@ -182,7 +195,7 @@ class _DeferSignals:
 def _simulate(args) -> int:
     import phsplit
     from . import scenario as scn
-    from .plotting import plot_positions, publish, reference_of
+    from .plotting import plot_dp, publish
 
     sc = scn.load(args.scenario) if args.scenario else scn.Scenario.paper_fig2()
     over = {}
@@ -284,7 +297,9 @@ def _simulate(args) -> int:
     files = [nc]
     if not args.no_plot:
         png = os.path.join(out, f"{name}.png")
-        plot_positions(_concat(sols), png, reference_of(sc.vessel))
+        from .results import _joined
+
+        plot_dp(_joined(sols), png)
         files.append(png)
     e = last.euler[-1]
     rr = max(float(s_.ledger.relative_residual().max()) for s_ in sols)
@@ -330,17 +345,6 @@ def _append(nc_file, path: str, sol, first: bool, attrs: dict):
                     nc_file.variables[name][n0:n0 + m, ...] = var.values
     nc_file.sync()
     return nc_file
-
-
-def _concat(sols):
-    """One Solution-like object of the chunks (for the plot)."""
-    import numpy as np
-    from types import SimpleNamespace
-
-    cat = lambda k: np.concatenate([getattr(s, k) if i == 0 else getattr(s, k)[1:]  # noqa: E731
-                                    for i, s in enumerate(sols)])
-    return SimpleNamespace(t=cat("t"), x=cat("x"), euler=cat("euler"), method=sols[0].method, h=sols[0].h,
-                           control_start=sols[0].control_start)
 
 
 def _reproduce(args) -> int:
@@ -429,6 +433,26 @@ def _rerun(args) -> int:
     return 1
 
 
+def _plot(args) -> int:
+    from .plotting import plot_dp
+    from .results import open_dataset
+
+    if args.watch_circle is not None and not (args.watch_circle > 0 and args.watch_circle < 1e6):
+        raise UsageError(f"--watch-circle must be a radius in m, > 0, got {args.watch_circle}")
+    out = args.out or os.path.splitext(args.file)[0] + ".png"
+    if os.path.splitext(out)[1].lower() not in (".png", ".pdf", ".svg"):
+        raise UsageError(f"--out must end in .png, .pdf or .svg, got {out!r}")
+    d = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(d):
+        raise UsageError(f"the folder of --out does not exist: {d!r}")
+    with open_dataset(args.file) as ds:
+        if "position" not in ds or "euler" not in ds:
+            raise UsageError(f"{args.file!r} holds no trajectory (it is not a run's file)")
+        plot_dp(ds, out, watch_circle=args.watch_circle)
+    print(f"wrote {os.path.abspath(out)}")
+    return 0
+
+
 def _methods() -> int:
     import phsplit
 
@@ -471,6 +495,8 @@ def main(argv: list[str] | None = None) -> int:
             return _sweep(args)
         if args.command == "rerun":
             return _rerun(args)
+        if args.command == "plot":
+            return _plot(args)
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

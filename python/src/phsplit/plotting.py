@@ -63,3 +63,107 @@ def reference_of(vessel) -> dict:
     c = vessel.to_dict()["control"]
     xr, er = np.asarray(c["position_reference"]), np.asarray(c["euler_reference"])
     return {"x": xr[0], "y": xr[1], "z": xr[2], "roll": er[0], "pitch": er[1], "yaw": er[2]}
+
+
+def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None = None) -> None:
+    """The main figure of a DP run, from a result dataset (``Solution.to_xarray()`` or a file
+    opened with ``phsplit.open_dataset``), written atomically to ``path``:
+
+    * the horizontal track (spatial x, y; z up) with the set point, the start and, if given, a
+      watch circle of radius ``watch_circle`` m about the set point;
+    * the horizontal distance to the set point and the heading error (degrees, wrapped);
+    * roll and pitch (degrees) and heave z (m);
+    * the controller's force (surge, sway; kN) and yaw moment (MN m), body frame;
+    * the stored energy H and the energy booked by each ledger account since the start (MJ).
+
+    A dotted line marks the start of the controller."""
+    import tomllib
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = np.asarray(ds["time"].values, dtype=float)
+    x = np.asarray(ds["position"].values)
+    eul = np.degrees(np.asarray(ds["euler"].values))
+    ref_x = ref_e = None
+    if "phsplit_vessel" in ds.attrs:
+        c = tomllib.loads(ds.attrs["phsplit_vessel"]).get("control")
+        if c:
+            ref_x, ref_e = np.asarray(c["position_reference"]), np.degrees(np.asarray(c["euler_reference"]))
+    tc = ds.attrs.get("control_start_s", "none")
+    tc = None if isinstance(tc, str) else float(tc)
+
+    fig = plt.figure(figsize=(15, 9), layout="constrained")
+    gs = fig.add_gridspec(3, 3)
+    ax_track = fig.add_subplot(gs[:, 0])
+    ax_track.plot(x[:, 1], x[:, 0], lw=1.2, label="track")
+    ax_track.plot(x[0, 1], x[0, 0], "o", color="C2", label="start")
+    if ref_x is not None:
+        ax_track.plot(ref_x[1], ref_x[0], "k+", ms=14, mew=2, label="set point")
+        if watch_circle:
+            a = np.linspace(0, 2 * np.pi, 361)
+            ax_track.plot(ref_x[1] + watch_circle * np.sin(a), ref_x[0] + watch_circle * np.cos(a), "r--", lw=1,
+                          label=f"watch circle {watch_circle:g} m")
+    ax_track.set_xlabel("y [m]")
+    ax_track.set_ylabel("x [m]")
+    ax_track.set_aspect("equal", adjustable="datalim")
+    ax_track.set_title("horizontal track (spatial frame, z up)")
+    ax_track.legend(fontsize=8, loc="best")
+    ax_track.grid(alpha=0.3)
+
+    axes = [fig.add_subplot(gs[i, j]) for i in range(3) for j in (1, 2)]
+    ax_pos, ax_head, ax_rp, ax_heave, ax_ctl, ax_en = axes
+    if ref_x is not None:
+        ax_pos.plot(t, np.hypot(x[:, 0] - ref_x[0], x[:, 1] - ref_x[1]), lw=1.2)
+        ax_pos.set_ylabel("distance to set point [m]")
+        if watch_circle:
+            ax_pos.axhline(watch_circle, color="r", ls="--", lw=1, label="watch circle")
+            ax_pos.legend(fontsize=8)
+        ax_head.plot(t, (eul[:, 2] - ref_e[2] + 180.0) % 360.0 - 180.0, lw=1.2)
+        ax_head.set_ylabel("heading error [deg]")
+    else:
+        ax_pos.plot(t, x[:, 0], label="x")
+        ax_pos.plot(t, x[:, 1], label="y")
+        ax_pos.set_ylabel("position [m]")
+        ax_pos.legend(fontsize=8)
+        ax_head.plot(t, eul[:, 2], lw=1.2)
+        ax_head.set_ylabel("yaw [deg]")
+    ax_rp.plot(t, eul[:, 0], lw=1.1, label="roll")
+    ax_rp.plot(t, eul[:, 1], lw=1.1, label="pitch")
+    ax_rp.set_ylabel("roll, pitch [deg]")
+    ax_rp.legend(fontsize=8)
+    ax_heave.plot(t, x[:, 2], lw=1.1)
+    ax_heave.set_ylabel("heave z [m]")
+    if "control_force" in ds:
+        f = np.asarray(ds["control_force"].values) / 1e3
+        mz = np.asarray(ds["control_moment"].values)[:, 2] / 1e6
+        ax_ctl.plot(t, f[:, 0], lw=1.1, label="surge force [kN]")
+        ax_ctl.plot(t, f[:, 1], lw=1.1, label="sway force [kN]")
+        ax2 = ax_ctl.twinx()
+        ax2.plot(t, mz, "C3", lw=1.1, label="yaw moment [MN m]")
+        ax2.set_ylabel("yaw moment [MN m]", color="C3")
+        ax_ctl.legend(fontsize=8, loc="upper right")
+    ax_ctl.set_ylabel("controller force [kN]")
+    ax_en.plot(t, np.asarray(ds["energy"].values) / 1e6, "k", lw=1.3, label="stored H")
+    for name in ds.data_vars:
+        if name.startswith("energy_") and name not in ("energy_supplied", "energy_dissipated", "energy_residual"):
+            kind = "dissipated" if "dissipated" in ds[name].attrs.get("long_name", "") else "supplied"
+            ax_en.plot(t, np.cumsum(np.nan_to_num(ds[name].values)) / 1e6, lw=1.0,
+                       label=f"{name[7:]} ({kind}, cumulative)")
+    ax_en.set_ylabel("energy [MJ]")
+    ax_en.legend(fontsize=7)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        if tc is not None and t[0] <= tc <= t[-1]:
+            ax.axvline(tc, color="0.5", ls=":", lw=1)
+    for ax in (ax_ctl, ax_en):
+        ax.set_xlabel("t [s]")
+    if tc is not None and t[0] <= tc <= t[-1]:
+        ax_pos.annotate("controller on", (tc, 1.0), xycoords=("data", "axes fraction"), fontsize=8, color="0.4",
+                        xytext=(3, -10), textcoords="offset points")
+    fig.suptitle(title or f"{ds.attrs.get('method', '').upper()}, h = {ds.attrs.get('step_size_s', '?')} s — "
+                 f"{ds.attrs.get('status', '')}, t = {t[0]:g} … {t[-1]:g} s")
+    _save(fig, path)
+    plt.close(fig)
