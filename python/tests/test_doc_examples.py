@@ -7,10 +7,10 @@ import doctest
 import pytest
 
 import phsplit
-from phsplit import results, rigid_body, so3, special
+from phsplit import events, results, rigid_body, so3, special
 
 
-@pytest.mark.parametrize("module", [special, rigid_body, so3, results, phsplit], ids=lambda m: m.__name__)
+@pytest.mark.parametrize("module", [special, rigid_body, so3, results, events, phsplit], ids=lambda m: m.__name__)
 def test_docstring_examples_run(module):
     result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE | doctest.ELLIPSIS)
     assert result.attempted > 0, f"{module.__name__} has no examples"

@@ -19,7 +19,7 @@ from ._core import (
     __version__,
 )
 from ._core import method_info as _method_info
-from . import results, rigid_body, so3, special
+from . import events, results, rigid_body, so3, special
 from .batch import simulate_many, with_parameters
 from .results import open_dataset, rerun
 from .scenario import Scenario
@@ -46,6 +46,7 @@ __all__ = [
     "StepSizeWarning",
     "Vessel",
     "__version__",
+    "events",
     "load_scenario",
     "method_info",
     "open_dataset",

@@ -222,6 +222,11 @@ class Solution:
         return self.moment(*[a for a in ("control", "control_damping") if a in self.ledger.by_account])
 
     @property
+    def events(self) -> list:
+        """The events found (``phsplit.events.EventHit``: name, t, state, terminal), in order."""
+        return list(self.meta.get("events", []))
+
+    @property
     def v(self) -> np.ndarray:
         """Body linear velocity (N, 3), m/s."""
         return self.p / self.meta["mass"]
@@ -448,6 +453,8 @@ def simulate(
     orthonormalize: bool = False,
     settings: Settings | None = None,
     progress: bool | Any = None,
+    save_at: Sequence[float] | np.ndarray | None = None,
+    events: Sequence[Any] | None = None,
 ) -> Solution:
     """Simulate the vessel with fixed steps ``h`` over ``t_span``.
 
@@ -478,6 +485,13 @@ def simulate(
     ``progress=True`` shows a progress bar (tqdm); a callable is called as
     ``progress(steps_done, n_steps)`` as often (an exception it raises stops the run and is
     raised).
+
+    ``save_at`` (times within ``t_span``) returns the states at exactly those times instead of the
+    grid's: each is one method step from the grid point before it, as a run ending there would
+    compute it (no interpolation). ``events`` (``phsplit.events``: watch circle, roll or pitch
+    beyond a limit, energy above a level, or your own condition) are located within a step to
+    1e-12 s in the partial-step length; a terminal one ends the run there (``status ==
+    "event"``), and every one found is in ``Solution.events``.
     """
     if not isinstance(vessel, Vessel):
         raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
@@ -500,6 +514,13 @@ def simulate(
         if y0.ndim != 1:
             raise _core.InvalidInputError(f"a flat initial state is a 1-D array of {_core.STATE_DIM} numbers, "
                                           f"got shape {y0.shape}")
+    if save_at is not None or events:
+        # Output at chosen times, or events: several core calls (phsplit.events).
+        from .events import run_with_outputs
+
+        if orthonormalize and y0 is not None:
+            raise _core.InvalidInputError("orthonormalize cannot be combined with save_at or events")
+        return run_with_outputs(vessel, settings, y0, save_at=save_at, events=events)
     if progress is True:
         from tqdm import tqdm
 

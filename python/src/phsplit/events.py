@@ -1,0 +1,340 @@
+"""Output when you want it, and events.
+
+``save_at``: the states at chosen times. phsplit steps *exactly* to each time: the run keeps its
+grid ``t0 + k h``, and the state at a time ``s`` between grid points ``t_k < s < t_{k+1}`` is one
+step of the method of length ``s − t_k`` from the grid state at ``t_k``, the very computation a
+run with ``t_span = (t0, s)`` ends with (its last, shorter step). So every ``save_at`` state
+has the method's order, and none is interpolated. The grid run itself is not changed by it.
+
+Events: a condition ``g(t, state) = 0`` watched after every step. A crossing between two grid
+points is located by the Illinois variant of regula falsi on the length ``τ`` of a partial step
+from the grid state before it (each trial one method step of length ``τ``), to ``|Δτ| ≤ 1e-12
+s``. The crossing time is then as accurate as the method's states are. A terminal event ends the
+run at the crossing; otherwise it is recorded and the run goes on. Built-in conditions:
+:func:`watch_circle` (horizontal distance to the set point), :func:`roll_beyond`,
+:func:`pitch_beyond`, :func:`energy_above`; any callable ``g(t, y)`` on the flat 27-vector state
+works too.
+
+Energy statement: the states at ``save_at`` times and at events lie on the method's own
+trajectory through partial steps, and the ledger between two of them is the grid run's booking up
+to the last grid point plus the partial step's own booking. ``ΔH = supplied − dissipated`` holds
+between any two of them as it does between grid points.
+
+>>> import phsplit
+>>> v = phsplit.Vessel.paper()
+>>> s = phsplit.simulate(v, (0.0, 100.0), 0.5, "sp2", control_start=0.0, save_at=[0.0, 12.34, 99.9])
+>>> s.t.tolist()
+[0.0, 12.34, 99.9]
+>>> e = phsplit.simulate(v, (0.0, 200.0), 0.5, "sp2", control_start=0.0,
+...                      events=[phsplit.events.watch_circle(30.0, direction="enter")])
+>>> e.status, round(e.events[0].t, 3)
+('event', 7.772)
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from . import _core
+
+__all__ = ["Event", "EventHit", "watch_circle", "roll_beyond", "pitch_beyond", "energy_above"]
+
+
+@dataclass(frozen=True)
+class Event:
+    """A condition ``g(t, y, vessel) = 0`` on the flat state ``y``; a crossing in ``direction``
+    (``"both"``, ``"rise"``: g goes from < 0 to ≥ 0, ``"fall"``: the reverse) is an event.
+    ``terminal`` ends the run there."""
+
+    name: str
+    g: Callable[[float, np.ndarray, Any], float]
+    direction: str = "both"
+    terminal: bool = True
+
+    def __post_init__(self):
+        if self.direction not in ("both", "rise", "fall"):
+            raise _core.InvalidInputError(f"event {self.name!r}: direction must be 'both', 'rise' or 'fall', "
+                                          f"got {self.direction!r}")
+        if not callable(self.g):
+            raise _core.InvalidInputError(f"event {self.name!r}: g must be callable g(t, y, vessel)")
+
+    def crosses(self, g0: float, g1: float) -> bool:
+        if not (math.isfinite(g0) and math.isfinite(g1)):
+            return False
+        rise, fall = g0 < 0.0 <= g1, g0 >= 0.0 > g1
+        return {"both": rise or fall, "rise": rise, "fall": fall}[self.direction]
+
+
+@dataclass(frozen=True)
+class EventHit:
+    """An event found: its name, time (s), the state there (flat 27-vector) and whether it
+    ended the run."""
+
+    name: str
+    t: float
+    state: np.ndarray = field(repr=False)
+    terminal: bool
+
+
+def _set_point(vessel) -> np.ndarray:
+    c = tomllib.loads(vessel.to_toml()).get("control")
+    if not c:
+        raise _core.InvalidInputError("watch_circle needs a set point: the vessel has no [control] table")
+    return np.asarray(c["position_reference"], dtype=float)
+
+
+def _positive(name: str, what: str, v) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v > 0):
+        raise _core.InvalidInputError(f"{name}: {what} must be a finite number > 0, got {v!r}")
+    return float(v)
+
+
+def watch_circle(radius: float, direction: str = "leave", terminal: bool = True) -> Event:
+    """The horizontal distance to the controller's set point crosses ``radius`` (m):
+    ``direction="leave"`` (outward, the alarm), ``"enter"`` or ``"both"``."""
+    r = _positive("watch_circle", "radius (m)", radius)
+    if direction not in ("leave", "enter", "both"):
+        raise _core.InvalidInputError(f"watch_circle: direction must be 'leave', 'enter' or 'both', got {direction!r}")
+    cache: dict[int, np.ndarray] = {}
+
+    def g(t, y, vessel):
+        ref = cache.setdefault(id(vessel), _set_point(vessel))
+        return math.hypot(y[18] - ref[0], y[19] - ref[1]) - r
+
+    d = {"leave": "rise", "enter": "fall", "both": "both"}[direction]
+    return Event(f"watch_circle_{r:g}m_{direction}", g, d, terminal)
+
+
+def _angle_event(which: int, label: str, limit_deg: float, terminal: bool) -> Event:
+    lim = math.radians(_positive(label, "limit (degrees)", limit_deg))
+
+    def g(t, y, vessel):
+        q = y[6:15].reshape(3, 3, order="F")
+        e = _core.euler_zyx(q.tolist())
+        return abs(e[which]) - lim
+
+    return Event(f"{label}_{limit_deg:g}deg", g, "rise", terminal)
+
+
+def roll_beyond(degrees: float, terminal: bool = True) -> Event:
+    """``|roll|`` rises above ``degrees``."""
+    return _angle_event(0, "roll_beyond", degrees, terminal)
+
+
+def pitch_beyond(degrees: float, terminal: bool = True) -> Event:
+    """``|pitch|`` rises above ``degrees``."""
+    return _angle_event(1, "pitch_beyond", degrees, terminal)
+
+
+def energy_above(joules: float, terminal: bool = True) -> Event:
+    """The stored energy H rises above ``joules``."""
+    e_max = _positive("energy_above", "energy (J)", joules)
+    return Event(f"energy_above_{e_max:g}J", lambda t, y, vessel: vessel.energy(y) - e_max, "rise", terminal)
+
+
+# ----------------------------------------------------------------------------------------------
+# the runs
+
+_FIELDS = ("x", "euler", "quaternion", "Q", "p", "m", "mu", "phi_th", "phi_x", "energy", "orthogonality_defect",
+           "account_force", "account_moment")
+
+
+def _check_times(save_at, t0: float, t1: float) -> np.ndarray:
+    try:
+        ts = np.asarray(save_at, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError("save_at must be a sequence of times (s)") from None
+    if ts.size == 0:
+        raise _core.InvalidInputError("save_at is empty: give at least one time (s)")
+    if not np.all(np.isfinite(ts)):
+        raise _core.InvalidInputError("save_at must hold finite times (s)")
+    if np.any(np.diff(ts) <= 0):
+        raise _core.InvalidInputError("save_at must be strictly increasing")
+    if ts[0] < t0 or ts[-1] > t1:
+        raise _core.InvalidInputError(f"save_at must lie within t_span [{t0:g}, {t1:g}] s, got "
+                                      f"[{ts[0]:g}, {ts[-1]:g}]")
+    return ts
+
+
+class _Rows:
+    """Rows taken from the Solutions of several core calls, with the cumulative ledger at each."""
+
+    def __init__(self):
+        self.rows: list[tuple[Any, int, float]] = []  # (solution, index, time)
+        self.cum: list[np.ndarray] = []
+
+    def add(self, sol, i: int, cum: np.ndarray, t: float | None = None):
+        self.rows.append((sol, i, float(sol.t[i]) if t is None else float(t)))
+        self.cum.append(np.array(cum, dtype=float))
+
+
+def _booked_steps(sol, names) -> np.ndarray:
+    """Per saved interval booking of a core call, (N, accounts), first row zero."""
+    return np.array([sol.ledger.by_account[n] for n in names]).T.reshape(len(sol.t), len(names))
+
+
+def _call(vessel, settings, t_a, t_b, h, y, save_every):
+    from .simulate import simulate
+
+    return simulate(vessel, initial=y, settings=replace(settings, t_span=(t_a, t_b), h=h, save_every=save_every))
+
+
+def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event] = ()):
+    """``simulate`` with ``save_at`` or ``events`` (see the module documentation)."""
+    events = list(events or ())
+    for ev in events:
+        if not isinstance(ev, Event):
+            raise _core.InvalidInputError(f"events must be phsplit.events.Event objects, got {type(ev).__name__}")
+    if save_at is not None and events:
+        raise _core.InvalidInputError("give save_at or events, not both: events end or mark the run on its own "
+                                      "saved states (save_every); save_at then has nothing to add")
+    checked = settings.checked()
+    n_steps = int(checked["n_steps"])
+    t0, t1 = settings.t_span
+    h = float(settings.h)
+    y = np.array(vessel.initial_state() if y0 is None else y0, dtype=float)
+    names: list[str] = list(dict(vessel.accounts))
+    rows = _Rows()
+    hits: list[EventHit] = []
+    status, failure, steps = "completed", None, 0
+
+    def t_at(k):
+        return t1 if k >= n_steps else t0 + k * h
+
+    if save_at is not None:
+        ts = _check_times(save_at, t0, t1)
+        k, cum = 0, np.zeros(len(names))
+        for s in ts:
+            kk = min(int(np.floor((s - t0) / h * (1.0 + 1e-12))), n_steps)
+            if t_at(kk) > s:  # round-off put the grid point past s
+                kk -= 1
+            if kk > k:
+                g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 10**9)
+                cum = cum + _booked_steps(g, names).sum(axis=0)
+                steps += g.steps
+                if g.status != "completed":
+                    status, failure = g.status, g.failure
+                    break
+                y, k = g.last_good_state, kk
+            tg = t_at(k)
+            tol = 1e-12 * max(1.0, abs(tg))
+            if abs(s - tg) <= tol:
+                p = _call(vessel, settings, tg, tg + h, h, y, 1)  # its row 0 is y itself
+                rows.add(p, 0, cum, t=s)
+            else:
+                p = _call(vessel, settings, tg, s, s - tg, y, 1)
+                if p.status != "completed":
+                    status, failure = p.status, p.failure
+                    break
+                rows.add(p, -1, cum + _booked_steps(p, names).sum(axis=0), t=s)
+    else:
+        k, cum = 0, np.zeros(len(names))
+        chunk = max(settings.save_every, 20_000 // settings.save_every * settings.save_every)
+        done = False
+        while k < n_steps and not done:
+            kk = min(k + chunk, n_steps)
+            g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 1)
+            b = _booked_steps(g, names)
+            cum_at = cum + np.cumsum(b, axis=0)
+            if k == 0:
+                rows.add(g, 0, cum_at[0])
+            for i in range(1, len(g.t)):
+                ya, yb = g.state(i - 1), g.state(i)
+                found = []
+                for ev in events:
+                    if ev.crosses(ev.g(float(g.t[i - 1]), ya, vessel), ev.g(float(g.t[i]), yb, vessel)):
+                        found.append((*_locate(vessel, settings, ev, float(g.t[i - 1]), ya,
+                                               float(g.t[i]) - float(g.t[i - 1]), names), ev))
+                found.sort(key=lambda f: f[0])
+                for te, part, w, ev in found:
+                    hits.append(EventHit(ev.name, te, part.state(-1), ev.terminal))
+                    if ev.terminal:
+                        rows.add(part, -1, cum_at[i - 1] + w, t=te)
+                        status, done = "event", True
+                        steps = k + i - 1
+                        break
+                if done:
+                    break
+                step_index = k + i
+                if step_index % settings.save_every == 0 or step_index == n_steps or i == len(g.t) - 1 and g.status != "completed":
+                    rows.add(g, i, cum_at[i])
+            if done:
+                break
+            steps = k + g.steps
+            if g.status != "completed":
+                status, failure = g.status, g.failure
+                break
+            y, k, cum = g.last_good_state, kk, cum_at[-1]
+    return _assemble(rows, names, status, failure, hits, steps, settings)
+
+
+def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, names):
+    """The crossing of ``ev`` within the step of length ``h`` from ``(t_a, y_a)``: Illinois
+    regula falsi on the partial-step length, to |Δτ| ≤ 1e-12 s (or 60 iterations). Returns the
+    time, the core call that ends there, and its booking."""
+
+    def at(tau):
+        return _call(vessel, settings, t_a, t_a + tau, tau, y_a, 1)
+
+    lo, hi = 0.0, h
+    best = at(h)
+    g_lo, g_hi = ev.g(t_a, y_a, vessel), ev.g(t_a + h, best.state(-1), vessel)
+    side = 0
+    for _ in range(60):
+        if hi - lo <= 1e-12:
+            break
+        tau = (lo * g_hi - hi * g_lo) / (g_hi - g_lo) if g_hi != g_lo else 0.5 * (lo + hi)
+        if not (lo < tau < hi):
+            tau = 0.5 * (lo + hi)
+        s = at(tau)
+        g = ev.g(t_a + tau, s.state(-1), vessel)
+        if ev.crosses(g_lo, g):  # the crossing is in [lo, tau]
+            hi, g_hi, best = tau, g, s
+            if side == 1:
+                g_lo *= 0.5
+            side = 1
+        else:
+            lo, g_lo = tau, g
+            if side == -1:
+                g_hi *= 0.5
+            side = -1
+    return t_a + hi, best, _booked_steps(best, names).sum(axis=0)
+
+
+def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
+    """One Solution of the recorded rows; the ledger between rows from the cumulative booking."""
+    from .simulate import Ledger, Solution
+
+    if not rows.rows:
+        raise _core.InvalidInputError("nothing was computed: the run failed at its first step")
+    src = rows.rows
+    pick = {f: np.array([getattr(s, f)[i] for s, i, _ in src]) for f in _FIELDS}
+    t = np.array([tt for _, _, tt in src])
+    cum = np.array(rows.cum).reshape(len(src), len(names))
+    booked = np.vstack([np.zeros((1, len(names))), np.diff(cum, axis=0)])
+    tmpl = src[-1][0]
+    kinds = tmpl.ledger.kinds
+    by_account = {nm: booked[:, k] for k, nm in enumerate(names)}
+    zero = np.zeros(len(t))
+    sup = zero + sum((by_account[nm] for nm in names if kinds[nm] == "supplied"), zero)
+    dis = zero + sum((by_account[nm] for nm in names if kinds[nm] == "dissipated"), zero)
+    e = pick["energy"]
+    sol = Solution(
+        t=t, x=pick["x"], euler=pick["euler"], quaternion=pick["quaternion"], Q=pick["Q"], p=pick["p"], m=pick["m"],
+        mu=pick["mu"], phi_th=pick["phi_th"], phi_x=pick["phi_x"], energy=e,
+        ledger=Ledger(dH=np.concatenate([[0.0], np.diff(e)]), supplied=sup, dissipated=dis, by_account=by_account,
+                      kinds=dict(kinds)),
+        orthogonality_defect=pick["orthogonality_defect"], status=status, method=tmpl.method, h=settings.h,
+        control_start=settings.control_start, steps=steps, failure=failure,
+        last_good_state=src[-1][0].state(src[-1][1]), meta=dict(tmpl.meta),
+        account_force=pick["account_force"], account_moment=pick["account_moment"],
+        settings={**tmpl.settings, "t_span": tuple(settings.t_span), "h": settings.h,
+                  "save_every": settings.save_every},
+    )
+    sol.meta["events"] = hits
+    sol.meta.pop("provenance", None)  # several core calls: not rerunnable as one
+    return sol

@@ -1,0 +1,103 @@
+"""Issue 14 (in part): output at chosen times and events, against independent references
+(tests/reference.py: eq. (39) in numpy, scipy DOP853 at tight tolerance, no phsplit code)."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import phsplit
+import reference as ref
+
+V = phsplit.Vessel.paper()
+P = V.to_dict()
+
+
+def test_save_at_is_a_run_stepped_exactly_to_those_times():
+    ts = [0.0, 0.5, 3.3, 10.0, 17.123, 40.0]
+    s = phsplit.simulate(V, (0.0, 40.0), 0.5, "sp4", control_start=5.0, save_at=ts)
+    np.testing.assert_array_equal(s.t, ts)
+    for i, t in enumerate(ts[1:], 1):
+        r = phsplit.simulate(V, (0.0, t), 0.5, "sp4", control_start=5.0)
+        np.testing.assert_array_equal(s.state(i), r.state(-1), err_msg=f"t = {t}")
+        assert s.energy[i] == r.energy[-1]
+    # the ledger closes between the chosen times as between grid points
+    assert np.all(s.ledger.relative_residual() < 1e-10)
+    assert s.status == "completed"
+
+
+@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
+def test_save_at_values_converge_at_the_methods_order(method, order):
+    """Off-grid times 0.37 and 0.81 s (controller on): the relative error of (p, m, x) against the
+    reference falls at the method's order."""
+    ts = np.array([0.37, 0.81])
+    y0 = V.initial_state()
+    _, yr = ref.solve(P, y0, 1.0, 0.0, t_eval=ts, rtol=1e-13)
+    hs = 2.0 ** -np.arange(2, 7)
+    errs = []
+    for h in hs:
+        s = phsplit.simulate(V, (0.0, 1.0), h, method, control_start=0.0, ledger=False, save_at=ts)
+        e = 0.0
+        for i in range(2):
+            for sl in (slice(0, 3), slice(3, 6), slice(18, 21)):
+                e = max(e, np.linalg.norm(s.state(i)[sl] - yr[i][sl]) / np.linalg.norm(yr[i][sl]))
+        errs.append(e)
+    errs = np.array(errs)
+    keep = errs > 1e-13
+    slope = np.polyfit(np.log(hs[keep]), np.log(errs[keep]), 1)[0]
+    assert abs(slope - order) < 0.3, (slope, errs)
+
+
+def test_a_watch_circle_crossing_is_located_to_1e_8_s():
+    """Entering a 30 m circle about the set point, controller on from t = 0; reference: the
+    numpy model by DOP853 at rtol 1e-13 with scipy's event location."""
+    ref_x = np.array(P["control"]["position_reference"])
+    field = ref.Field(P, True)
+    y0 = V.initial_state()
+
+    def g(t, y):
+        return np.hypot(y[18] - ref_x[0], y[19] - ref_x[1]) - 30.0
+
+    g.terminal, g.direction = True, -1
+    r = solve_ivp(field, (0.0, 60.0), y0, method="DOP853", rtol=1e-13,
+                  atol=np.maximum(np.abs(y0), 1.0) * 1e-16, events=g)
+    t_ref = float(r.t_events[0][0])
+    s = phsplit.simulate(V, (0.0, 60.0), 0.01, "sp4", control_start=0.0,
+                         events=[phsplit.events.watch_circle(30.0, direction="enter")])
+    assert s.status == "event" and len(s.events) == 1
+    hit = s.events[0]
+    assert abs(hit.t - t_ref) < 1e-8, (hit.t, t_ref)
+    assert s.t[-1] == hit.t and abs(np.hypot(*(s.x[-1, :2] - ref_x[:2])) - 30.0) < 1e-9
+    assert np.all(s.ledger.relative_residual() < 1e-10)
+
+
+def test_non_terminal_events_are_recorded_and_the_run_goes_on():
+    ev = [phsplit.events.watch_circle(30.0, direction="enter", terminal=False),
+          phsplit.events.roll_beyond(1.0, terminal=False)]
+    s = phsplit.simulate(V, (0.0, 60.0), 0.5, "sp2", control_start=0.0, events=ev)
+    assert s.status == "completed" and s.t[-1] == 60.0
+    names = [e.name for e in s.events]
+    assert "watch_circle_30m_enter" in names and any(n.startswith("roll_beyond") for n in names)
+    times = [e.t for e in s.events]
+    assert times == sorted(times)
+    # each recorded crossing is a crossing: the roll there is 1 degree
+    for e in s.events:
+        if e.name.startswith("roll"):
+            q = e.state[6:15].reshape(3, 3, order="F")
+            assert abs(abs(phsplit.so3.euler_zyx(q)[0]) - np.radians(1.0)) < 1e-9
+
+
+def test_energy_event_and_bad_arguments():
+    s = phsplit.simulate(V, (0.0, 100.0), 0.5, "sp2", control_start=0.0,
+                         events=[phsplit.events.energy_above(2.0e6)])
+    assert s.status == "event" and abs(s.energy[-1] - 2.0e6) < 1e-3
+    for kw, words in (({"save_at": [5.0, 1.0]}, "increasing"), ({"save_at": [-1.0]}, "within t_span"),
+                      ({"save_at": []}, "empty"), ({"events": ["watch"]}, "Event objects"),
+                      ({"save_at": [1.0], "events": [phsplit.events.energy_above(1.0)]}, "not both")):
+        with pytest.raises(phsplit.InvalidInputError, match=words):
+            phsplit.simulate(V, (0.0, 10.0), 0.5, "sp2", **kw)
+    for make, words in ((lambda: phsplit.events.watch_circle(-1.0), "radius"),
+                        (lambda: phsplit.events.watch_circle(5.0, direction="out"), "direction"),
+                        (lambda: phsplit.events.roll_beyond(float("nan")), "limit")):
+        with pytest.raises(phsplit.InvalidInputError, match=words):
+            make()
