@@ -69,6 +69,15 @@ def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
     with phsplit.open_dataset(store / "summary.nc") as s:
         status = list(s["status"].values)
     assert status.count("invalid") == 3 and status.count("completed") == 6
+    # the computed cases as one lazy dataset with a case dimension
+    with phsplit.open_sweep(store) as all_cases:
+        assert all_cases.sizes["case"] == 6 and all_cases["position"].chunks is not None
+        ran = [sw.case_id(i) for i in range(9) if sw.cases[i]["vessel.mass"] > 0]
+        assert list(all_cases["case_id"].values) == ran
+        i = 4  # the case's own file holds the same numbers
+        with phsplit.open_dataset(store / "cases" / f"{ran[i]}.nc") as one:
+            np.testing.assert_array_equal(all_cases["position"].isel(case=i).values, one["position"].values)
+        np.testing.assert_array_equal(all_cases["vessel_mass"].values, [6e6, 7e6] * 3)
     # a second run reuses everything
     t0 = time.monotonic()
     res = run_sweep(sw, str(store), n_workers=2, progress=False)

@@ -21,7 +21,7 @@ from ._core import (
 from ._core import method_info as _method_info
 from . import events, results, rigid_body, so3, special
 from .batch import simulate_many, with_parameters
-from .results import open_dataset, rerun
+from .results import open_dataset, open_sweep, rerun
 from .scenario import Scenario
 from .scenario import load as load_scenario
 from .simulate import Ledger, PassivityWarning, Settings, Solution, StepSizeWarning, Vessel, simulate
@@ -50,6 +50,7 @@ __all__ = [
     "load_scenario",
     "method_info",
     "open_dataset",
+    "open_sweep",
     "rerun",
     "results",
     "rigid_body",

@@ -30,7 +30,7 @@ import numpy as np
 from . import _core
 from .simulate import Settings, Solution, Vessel, simulate
 
-__all__ = ["open_dataset", "rerun", "compare", "run_chunks", "settings_of", "vessel_of"]
+__all__ = ["open_dataset", "open_sweep", "rerun", "compare", "run_chunks", "settings_of", "vessel_of", "cf_finish"]
 
 
 def open_dataset(path: str | os.PathLike[str], **kw: Any):
@@ -198,4 +198,42 @@ def cf_finish(ds, title: str, what: str):
         "phsplit_version": _core.__version__,
         **{k: v for k, v in ds.attrs.items() if k not in ("Conventions", "title", "history")},
     }
+    return ds
+
+
+def open_sweep(store: str | os.PathLike[str]):
+    """The cases of a sweep store (``phsplit sweep``) as one dataset with a ``case`` dimension,
+    opened lazily through Dask (``xarray.open_mfdataset``), in the order of the sweep file.
+    Cases that did not run (invalid parameters) are left out; ``summary.nc`` lists every case
+    with its status. The varied parameters are coordinates along ``case``, and ``case_id``
+    names each."""
+    import json
+
+    import xarray as xr
+
+    root = os.fspath(store)
+    meta = os.path.join(root, "sweep.json")
+    if not os.path.isfile(meta):
+        raise _core.InvalidInputError(f"{root!r} is not a sweep store (no sweep.json in it)")
+    with open(meta) as f:
+        cases = json.load(f)["cases"]
+    paths, ids, params = [], [], []
+    for cid, case in cases.items():
+        p = os.path.join(root, "cases", f"{cid}.nc")
+        if not os.path.isfile(p):
+            continue  # not computed yet
+        with xr.open_dataset(p, decode_times=False) as d:
+            if "time" not in d.dims:
+                continue  # an invalid case: nothing ran
+        paths.append(p)
+        ids.append(cid)
+        params.append(case)
+    if not paths:
+        raise _core.InvalidInputError(f"the sweep store {root!r} holds no computed case yet")
+    ds = xr.open_mfdataset(paths, combine="nested", concat_dim="case", decode_times=False,
+                           data_vars="all", coords="minimal", compat="override", combine_attrs="drop_conflicts")
+    ds = ds.assign_coords(case_id=("case", np.array(ids)))
+    for k in sorted({k for c in params for k in c}):
+        name = k.replace(".", "_").replace("[", "_").replace("]", "")
+        ds = ds.assign_coords({name: ("case", np.array([c.get(k, np.nan) for c in params], float), {"parameter": k})})
     return ds
