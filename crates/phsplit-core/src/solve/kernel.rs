@@ -151,7 +151,7 @@ pub fn run_runge_kutta_watched<const N: usize, M: FieldModel<N>>(
             rec.traj.t_last_good = t;
             return Ok(rec.fail(n, t));
         }
-        if model.projects() {
+        if model.projects() && model.projects_runge_kutta() {
             let mut st = model.from_vector(&y1);
             work += model.project(&mut st);
             y1 = model.to_vector(&st);

@@ -79,6 +79,12 @@ pub trait Model {
     fn project(&self, _s: &mut Self::State) -> Work {
         Work::default()
     }
+    /// Whether Runge–Kutta methods need the projection too. A Runge–Kutta method keeps every
+    /// linear invariant of the field to round-off, so a model whose projected invariants are
+    /// linear in the state says `false` here and its Runge–Kutta runs skip the projection.
+    fn projects_runge_kutta(&self) -> bool {
+        true
+    }
 }
 
 /// Which of the two flows of a split model a sub-step belongs to.

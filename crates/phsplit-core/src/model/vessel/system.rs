@@ -434,6 +434,10 @@ impl Model for VesselSystem<'_> {
     fn projects(&self) -> bool {
         self.project
     }
+    /// The restoring invariant `mu − G Qᵀe3` is linear in the state: Runge–Kutta keeps it.
+    fn projects_runge_kutta(&self) -> bool {
+        false
+    }
     fn project(&self, s: &mut VesselState) -> Work {
         for f in &self.vessel.forces {
             f.project(s);
