@@ -10,6 +10,32 @@ systems*, Multibody System Dynamics 44 (2018) 251–275, on a Rust core.
 """
 from __future__ import annotations
 
+
+def _early_signal(signum, frame):  # pragma: no cover - exercised by the CLI's signal test
+    import os
+
+    os.write(2, b"phsplit: interrupted while starting; nothing was written\n")
+    os._exit(130)
+
+
+def _quiet_start() -> None:
+    """When this import is the start of the ``phsplit`` command (the console script, or
+    ``python -m phsplit``), Ctrl-C or SIGTERM before the CLI installs its own handlers ends the
+    process with one line and status 130 instead of a traceback (nothing has been written
+    then). A library import is left alone."""
+    import os
+    import signal
+    import sys
+
+    exe = os.path.basename(sys.argv[0]) if sys.argv else ""
+    if exe in ("phsplit", "-m") and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _early_signal)
+        if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
+            signal.signal(signal.SIGTERM, _early_signal)
+
+
+_quiet_start()
+
 from ._core import (
     METHODS,
     IntegrationError,

@@ -470,23 +470,26 @@ def _sigterm(signum, frame):
 def main(argv: list[str] | None = None) -> int:
     import signal
 
-    if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
-        signal.signal(signal.SIGTERM, _sigterm)  # clean up staging files as on Ctrl-C
-    import warnings
-
-    def _show(message, category, filename, lineno, file=None, line=None):
-        print(f"phsplit: warning: {message}", file=sys.stderr)  # one line, no source location
-
-    warnings.showwarning = _show
-    parser = _parser()
-    args = parser.parse_args(argv)
-    args.argv = list(argv) if argv is not None else sys.argv[1:]
-    if args.command is None:
-        parser.print_help()
-        return 2
     import phsplit
 
     try:
+        if signal.getsignal(signal.SIGINT) is phsplit._early_signal:  # the command's own start
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+            signal.signal(signal.SIGTERM, _sigterm)
+        if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
+            signal.signal(signal.SIGTERM, _sigterm)  # clean up staging files as on Ctrl-C
+        import warnings
+
+        def _show(message, category, filename, lineno, file=None, line=None):
+            print(f"phsplit: warning: {message}", file=sys.stderr)  # one line, no source location
+
+        warnings.showwarning = _show
+        parser = _parser()
+        args = parser.parse_args(argv)
+        args.argv = list(argv) if argv is not None else sys.argv[1:]
+        if args.command is None:
+            parser.print_help()
+            return 2
         if args.command == "simulate":
             return _simulate(args)
         if args.command == "reproduce":
