@@ -56,7 +56,8 @@ def main() -> int:
         shutil.rmtree(store, ignore_errors=True)
     lines = ["# Sweep throughput", "",
              f"{n} one-hour SP2 cases (h = 0.5 s, 7,200 steps each, exact S2, ledger on, every 20th step saved, "
-             f"summary per case), {cores} logical cores.", "", "| how | wall time [s] | cases per second |",
+             f"summary per case; default settings, so with the projection onto the restoring invariant, "
+             f"docs/model.md §3.6), {cores} logical cores.", "", "| how | wall time [s] | cases per second |",
              "|---|---|---|"]
     lines += [f"| {a} | {b:.1f} | {c:.1f} |" for a, b, c in rows]
     text = "\n".join(lines) + "\n"
