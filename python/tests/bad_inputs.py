@@ -90,7 +90,10 @@ def cli(*args: str, files: dict[str, bytes] | None = None) -> Callable[[], objec
             os.chdir(d)
             try:
                 with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
-                    code = main(list(args))
+                    try:
+                        code = main(list(args))
+                    except SystemExit as e:  # argparse's usage errors
+                        code = e.code
             finally:
                 os.chdir(here)
             stray = [n for n in os.listdir(top) if n != "work"]
@@ -235,6 +238,26 @@ CATALOGUE: list[Bad] = [
     Bad("CLI: missing scenario file", cli("simulate", "nowhere.toml", "--out", "out"), C, ("nowhere.toml",)),
     Bad("CLI: output folder that is a file", cli(*SIM[:-3], "--out", "f", "--t-end", "1", files={"f": b"x"}), C,
         ("output folder", "f")),
+    Bad("CLI: step that is not a number", cli(*SIM, "--h", "abc"), C, ("--h", "invalid float value", "--help")),
+    Bad("CLI: unknown command", cli("simulat"), C, ("invalid choice", "simulate")),
+    Bad("CLI: option without its value", cli(*SIM, "--method"), C, ("--method", "expected one argument")),
+    Bad("CLI: rerun of a file that is not phsplit's", cli("rerun", "x.nc", files={"x.nc": b"CDF\x01junk"}), C,
+        ("x.nc", "not a NetCDF file")),
+    Bad("CLI: plot with a negative watch circle", cli("plot", "x.nc", "--watch-circle", "-5"), C, ("--watch-circle", "> 0")),
     Bad("CLI: sweep without [sweep]", cli("sweep", "s.toml", "--out", "st", files={"s.toml": b"[simulation]\nh = 1.0\n"}),
         C, ("[sweep]",)),
+]
+
+CATALOGUE += [
+    # issue 13: more API mistakes, each an InvalidInputError
+    Bad("method given as None", sim(method=None), E, ("method", "None")),
+    Bad("settings that are not a Settings", lambda: phsplit.simulate(phsplit.Vessel.paper(), settings={"h": 1.0}), E,
+        ("settings", "phsplit.Settings")),
+    Bad("parameter value that is not a number", lambda: phsplit.with_parameters(phsplit.Vessel.paper(),
+                                                                                {"vessel.mass": "heavy"}), E,
+        ("vessel.mass", "number")),
+    Bad("cases that are not a list of mappings", lambda: phsplit.simulate_many(5), E, ("cases", "sequence of mappings")),
+    Bad("save_at outside the span", sim(save_at=[-1.0, 5.0]), E, ("save_at", "within t_span")),
+    Bad("watch circle of negative radius", lambda: phsplit.events.watch_circle(-5.0), E, ("radius", "> 0")),
+    Bad("open_dataset of a missing file", lambda: phsplit.open_dataset("/nonexistent/run.nc"), E, ("does not exist",)),
 ]

@@ -40,6 +40,8 @@ _PATH = re.compile(r"^([a-z_]+)\.([a-z_]+)(?:\[([0-9]+)\])?$")
 
 def _resolve(d: dict, key: str) -> tuple[str, str, int | None]:
     """Check a parameter path against a vessel's dict: (table, name, index or None)."""
+    if not isinstance(key, str):
+        raise _core.InvalidInputError(f"a parameter path is a string 'table.name' or 'table.name[i]', got {key!r}")
     m = _PATH.match(key)
     if not m or not isinstance(d.get(m.group(1)), dict) or m.group(2) not in d[m.group(1)]:
         valid = sorted(f"{s}.{k}" for s in d if isinstance(d[s], dict) for k in d[s])
@@ -61,9 +63,15 @@ def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
     """``base`` with parameters replaced: keys ``table.name`` or ``table.name[i]`` of the vessel
     file (``vessel``, ``control``, ``initial``, ``external``, …). Unknown paths and bad values
     raise InvalidInputError."""
+    if not isinstance(base, Vessel):
+        raise _core.InvalidInputError(f"base must be a phsplit.Vessel, got {type(base).__name__}")
+    if not isinstance(params, Mapping):
+        raise _core.InvalidInputError(f"parameters must be a mapping of paths to numbers, got {type(params).__name__}")
     d = base.to_dict()
     for key, value in params.items():
         sec, name, idx = _resolve(d, key)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise _core.InvalidInputError(f"parameter {key!r} must be a number, got {value!r}")
         if idx is None:
             d[sec][name] = float(value)
         else:
@@ -110,6 +118,12 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
 
     base = base or Vessel.paper()
     settings = settings or Settings(**kw)
+    if not isinstance(settings, Settings):
+        raise _core.InvalidInputError(f"settings must be a phsplit.Settings, got {type(settings).__name__}")
+    if isinstance(cases, (str, bytes, Mapping)) or not isinstance(cases, Sequence) or not all(
+            isinstance(c, Mapping) for c in cases):
+        raise _core.InvalidInputError("cases must be a sequence of mappings {parameter path: value}, "
+                                      f"got {type(cases).__name__}")
     keys = sorted({k for c in cases for k in c})
 
     def one(case):

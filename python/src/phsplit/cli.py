@@ -22,8 +22,15 @@ EXAMPLES = """examples:
 """
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its usage errors on one line (``phsplit: error: …``), exit status 2."""
+
+    def error(self, message):
+        self.exit(2, f"phsplit: error: {self.prog}: {message} (see '{self.prog} --help')\n")
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="phsplit",
         description="Passivity-preserving splitting simulation of a vessel under DP control.",
         epilog=EXAMPLES,

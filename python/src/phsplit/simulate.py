@@ -424,9 +424,21 @@ class Settings:
     project_invariants: bool = _DEFAULTS["project_invariants"]
 
     def as_core(self) -> dict[str, Any]:
+        """The settings as the core takes them: numpy scalars as Python numbers, ``None`` for
+        ``control_start`` as ``"never"``; ``None`` anywhere else is refused by name."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
         if d["control_start"] is None:
             d["control_start"] = "never"
+        what = dict(_core.settings_keys())
+        for k, v in d.items():
+            if v is None:
+                raise _core.InvalidInputError(f"{k} must be given ({what.get(k, 'a value')}), got None")
+            if isinstance(v, np.bool_):
+                d[k] = bool(v)
+            elif isinstance(v, np.integer):
+                d[k] = int(v)
+            elif isinstance(v, np.floating):
+                d[k] = float(v)
         return d
 
     def checked(self) -> dict[str, Any]:
@@ -499,6 +511,8 @@ def simulate(
         settings = Settings(t_span=t_span, h=h, method=method, control_start=control_start, outer=outer,
                             save_every=save_every, linear_flow=linear_flow, ledger=ledger,
                             project_invariants=project_invariants)
+    elif not isinstance(settings, Settings):
+        raise _core.InvalidInputError(f"settings must be a phsplit.Settings, got {type(settings).__name__}")
     if isinstance(settings.save_every, float):
         raise _core.InvalidInputError(f"save_every must be an integer >= 1, got {settings.save_every!r}")
     if initial is None:
