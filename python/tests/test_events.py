@@ -101,3 +101,15 @@ def test_energy_event_and_bad_arguments():
                         (lambda: phsplit.events.roll_beyond(float("nan")), "limit")):
         with pytest.raises(phsplit.InvalidInputError, match=words):
             make()
+
+
+def test_dense_output_on_request_is_a_run_stepped_to_each_time():
+    s = phsplit.simulate(V, (0.0, 60.0), 0.5, "sp2", control_start=5.0, save_every=7)
+    ts = [0.0, 3.3, 14.0, 33.71, 59.99, 60.0]
+    d = s.at(ts)
+    np.testing.assert_array_equal(d.t, ts)
+    for i, t in enumerate(ts[1:], 1):
+        r = phsplit.simulate(V, (0.0, t), 0.5, "sp2", control_start=5.0)
+        np.testing.assert_allclose(d.state(i), r.state(-1), rtol=1e-12, atol=1e-9, err_msg=f"t = {t}")
+    with pytest.raises(phsplit.InvalidInputError, match="within the run"):
+        s.at([61.0])

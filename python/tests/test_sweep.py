@@ -180,3 +180,20 @@ def test_the_yaw_error_is_wrapped():
     v = phsplit.Vessel.from_dict(d)
     s = phsplit.simulate(v, (0.0, 1.0), 0.5, "sp2", control_start=None)
     assert abs(summarize(v, s)["yaw_error_rad"] - (2 * np.pi - 6.2)) < 1e-3
+
+
+def test_summary_peaks_cover_every_step_not_only_the_saved_ones():
+    """Issue 14: with every 50th state saved, the summary's peak force is still the peak over
+    every step (the run that saves every step, computed independently from its saved states)."""
+    from phsplit.batch import summarize
+
+    v = phsplit.Vessel.paper()
+    every = phsplit.simulate(v, (0.0, 100.0), 0.25, "sp2", control_start=10.0)
+    peak = float(np.max(np.linalg.norm(every.control_force, axis=1)))
+    sparse = phsplit.simulate(v, (0.0, 100.0), 0.25, "sp2", control_start=10.0, save_every=50, running_max=True)
+    assert abs(summarize(v, sparse)["peak_force_N"] - peak) <= 1e-12 * peak
+    sampled = float(np.max(np.linalg.norm(sparse.control_force, axis=1)))
+    assert sampled < peak  # what the saved states alone would report
+    ds = phsplit.simulate_many([{"vessel.mass": 6.3622085e6}], settings=phsplit.Settings(
+        t_span=(0.0, 100.0), h=0.25, method="sp2", control_start=10.0, save_every=50))
+    assert abs(float(ds["peak_force_N"][0]) - peak) <= 1e-12 * peak

@@ -382,7 +382,7 @@ impl Monitor for PyMonitor {
 /// released while integrating; signals are checked about every 0.1 s, and Ctrl-C returns what
 /// was computed with status "interrupted". `progress(steps_done, n_steps)` is called as often.
 #[pyfunction]
-#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None))]
+#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None, extrema=false))]
 fn integrate<'py>(
     py: Python<'py>,
     vessel: &PyVessel,
@@ -390,6 +390,7 @@ fn integrate<'py>(
     state0: Option<PyReadonlyArray1<'_, f64>>,
     orthonormalize: bool,
     progress: Option<Py<PyAny>>,
+    extrema: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (settings, _) = settings_of(settings, true)?;
     let opts = settings.options().map_err(to_py)?;
@@ -412,7 +413,8 @@ fn integrate<'py>(
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 let sys = VesselSystem::new(&v, s2.control_start)
                     .with_linear_flow(s2.linear_flow)
-                    .with_projection(s2.project_invariants);
+                    .with_projection(s2.project_invariants)
+                    .with_extrema(extrema);
                 let traj = run_watched(&sys, &s2.method, y0, &opts, mon)?;
                 // The force and moment of each account at the saved states.
                 let wrenches: Vec<_> = traj
@@ -491,6 +493,11 @@ fn integrate<'py>(
     d.set_item("steps", traj.steps)?;
     d.set_item("last_good", PyArray1::from_slice(py, traj.last_good.to_vector().as_slice()))?;
     d.set_item("t_last_good", traj.t_last_good)?;
+    let ext = PyDict::new(py);
+    for (k, name) in traj.probe_names.iter().enumerate() {
+        ext.set_item(*name, (traj.probe_max[k], traj.probe_max_t[k]))?;
+    }
+    d.set_item("running_max", ext)?;
     d.set_item("settings", settings_dict(py, &settings, None)?)?;
     match traj.status {
         Status::Completed => d.set_item("status", "completed")?,

@@ -80,12 +80,17 @@ def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
 
 
 def summarize(vessel: Vessel, sol) -> dict[str, Any]:
-    """Per-case summary: final distances to the set point, energy, peak control effort (the
-    controller's force and moment as the core computes them, at the saved states), status."""
+    """Per-case summary: final distances to the set point (the yaw error wrapped), energy, peak
+    control effort (the norms of the controller's force and moment, over every step when the run
+    kept its running maxima, as sweeps and ``simulate_many`` do; else over the saved states),
+    status."""
     c = vessel.to_dict()["control"]
     xr_, er = np.asarray(c["position_reference"]), np.asarray(c["euler_reference"])
     peak_t = peak_r = 0.0
-    if len(sol.t):
+    rm = sol.meta.get("running_max", {})
+    if "control_force" in rm:  # over every step (the core's running maxima)
+        peak_t, peak_r = float(rm["control_force"][0]), float(rm["control_moment"][0])
+    elif len(sol.t):  # over the saved states only
         peak_t = float(np.max(np.linalg.norm(sol.control_force, axis=1)))
         peak_r = float(np.max(np.linalg.norm(sol.control_moment, axis=1)))
     bound = 100.0 * (sol.energy[0] + max(0.0, float(np.sum(sol.ledger.supplied))))
@@ -131,7 +136,7 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
             v = with_parameters(base, case)
         except (_core.InvalidInputError, _core.ScenarioParseError) as e:
             return None, {"status": "invalid", "error": str(e)}
-        sol = settings.run(v)
+        sol = settings.run(v, running_max=True)  # peaks over every step
         return sol, {**summarize(v, sol), "error": sol.failure or ""}
 
     with cf.ThreadPoolExecutor(max_workers=max_workers or os.cpu_count() or 2) as pool:
@@ -283,7 +288,7 @@ def _run_case(base_tables: dict, settings: Settings, case: dict) -> dict:
         v = with_parameters(base, case)
     except (_core.InvalidInputError, _core.ScenarioParseError) as e:
         return {"status": "invalid", "error": str(e), "case": case}
-    sol = settings.run(v)
+    sol = settings.run(v, running_max=True)  # peaks over every step
     ds = sol.to_xarray()
     return {"status": sol.status, "error": sol.failure or "", "case": case, "summary": summarize(v, sol),
             "dataset": ds}

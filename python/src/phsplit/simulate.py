@@ -221,6 +221,40 @@ class Solution:
         """The controller's moment (P, I and D terms), body frame (N, 3), N m."""
         return self.moment(*[a for a in ("control", "control_damping") if a in self.ledger.by_account])
 
+    def at(self, times: Sequence[float] | np.ndarray) -> "Solution":
+        """Dense output on request: the states at any ``times`` within the run, each computed by
+        stepping from the last saved state at or before it with the run's step and a last,
+        shorter step (as ``save_at`` does), so with the method's own order and no interpolation.
+        One core call per time. The result's ledger is zero (states only)."""
+        from .events import _assemble, _call, _Rows
+
+        prov = self.meta.get("provenance")
+        if not prov or "vessel_toml" not in prov:
+            raise _core.InvalidInputError("this Solution does not record its vessel (it was assembled from several "
+                                          "runs); rerun with save_at instead")
+        ts = np.asarray(times, dtype=float).reshape(-1)
+        if ts.size == 0 or not np.all(np.isfinite(ts)) or ts.min() < self.t[0] or ts.max() > self.t[-1]:
+            raise _core.InvalidInputError(f"times must be finite and within the run [{self.t[0]:g}, {self.t[-1]:g}] s")
+        vessel = Vessel.from_toml_str(prov["vessel_toml"])
+        cs = self.settings.get("control_start")
+        base = Settings(t_span=tuple(self.settings["t_span"]), h=self.h, method=self.method, control_start=cs,
+                        outer=self.settings["outer"], save_every=1, linear_flow=self.settings["linear_flow"],
+                        ledger=bool(self.settings["ledger"]),
+                        project_invariants=bool(self.settings.get("project_invariants", True)))
+        names = list(self.ledger.by_account)
+        rows = _Rows()
+        zero = np.zeros(len(names))
+        for t in ts:
+            i = int(np.searchsorted(self.t, t, side="right")) - 1
+            if self.t[i] == t:
+                p = _call(vessel, base, t, t + self.h, self.h, self.state(i), 1)
+                rows.add(p, 0, zero, t=t)
+            else:
+                span = float(t) - float(self.t[i])
+                p = _call(vessel, base, float(self.t[i]), float(t), min(self.h, span), self.state(i), 1)
+                rows.add(p, -1, zero, t=t)
+        return _assemble(rows, names, "completed", None, [], 0, base)
+
     @property
     def events(self) -> list:
         """The events found (``phsplit.events.EventHit``: name, t, state, terminal), in order."""
@@ -467,6 +501,7 @@ def simulate(
     progress: bool | Any = None,
     save_at: Sequence[float] | np.ndarray | None = None,
     events: Sequence[Any] | None = None,
+    running_max: bool = False,
 ) -> Solution:
     """Simulate the vessel with fixed steps ``h`` over ``t_span``.
 
@@ -503,7 +538,9 @@ def simulate(
     compute it (no interpolation). ``events`` (``phsplit.events``: watch circle, roll or pitch
     beyond a limit, energy above a level, or your own condition) are located within a step to
     1e-12 s in the partial-step length; a terminal one ends the run there (``status ==
-    "event"``), and every one found is in ``Solution.events``.
+    "event"``), and every one found is in ``Solution.events``. ``running_max=True`` keeps the
+    largest controller force and moment over every step, saved or not
+    (``Solution.meta["running_max"]``: name → (value, time)).
     """
     if not isinstance(vessel, Vessel):
         raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
@@ -552,7 +589,7 @@ def simulate(
                                       f"got {type(progress).__name__}")
     _warn_if_step_too_long(vessel, y0, settings)
     try:
-        raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), cb)
+        raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), cb, bool(running_max))
     finally:
         if bar is not None:
             bar.close()
@@ -579,6 +616,7 @@ def simulate(
         account_force=raw["account_force"], account_moment=raw["account_moment"], settings=dict(used),
     )
     # What reruns it (phsplit rerun): the vessel file, the initial state the core used, one chunk.
+    sol.meta["running_max"] = dict(raw["running_max"])
     sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0),
                               "chunks": [int(used["n_steps"])]}
     return sol

@@ -82,6 +82,7 @@ pub fn run_splitting_watched<M: SplitModel>(
             // y sits on the step boundary (no sub-step deferred into the next step).
             rec.traj.last_good = y;
             rec.traj.t_last_good = t1;
+            rec.observe(t1, &y);
         }
         let saved = saves_after(n, opts);
         if saved {
@@ -158,6 +159,9 @@ pub fn run_runge_kutta_watched<const N: usize, M: FieldModel<N>>(
         }
         y = y1;
         rec.acc += work;
+        if !rec.traj.probe_names.is_empty() {
+            rec.observe(t1, &model.from_vector(&y));
+        }
         rec.traj.steps = n + 1;
         let saved = saves_after(n, opts);
         if saved {

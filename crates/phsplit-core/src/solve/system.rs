@@ -85,6 +85,13 @@ pub trait Model {
     fn projects_runge_kutta(&self) -> bool {
         true
     }
+    /// Names of quantities whose running maxima over every step the kernels keep (at most
+    /// [`MAX_ACCOUNTS`]; none by default): peaks that saving every k-th state would miss.
+    fn probe_names(&self) -> &[&'static str] {
+        &[]
+    }
+    /// The probed quantities at `s`, with the field of a step that starts at `t`.
+    fn probe(&self, _t: f64, _s: &Self::State, _out: &mut [f64]) {}
 }
 
 /// Which of the two flows of a split model a sub-step belongs to.

@@ -1,7 +1,7 @@
 //! What a run returns: saved states, the energy ledger per saved interval, and how it ended.
 
 use super::options::Options;
-use super::system::{Account, AccountKind, Model, Work};
+use super::system::{Account, AccountKind, Model, Work, MAX_ACCOUNTS};
 
 /// How a run ended.
 #[derive(Debug, Clone, PartialEq)]
@@ -67,6 +67,11 @@ pub struct Trajectory<S> {
     pub last_good: S,
     /// Time of `last_good`.
     pub t_last_good: f64,
+    /// The model's probed quantities ([`crate::solve::Model::probe_names`]), their largest value
+    /// over every step boundary of the run (the initial state included) and when it occurred.
+    pub probe_names: Vec<&'static str>,
+    pub probe_max: Vec<f64>,
+    pub probe_max_t: Vec<f64>,
 }
 
 impl<S> Trajectory<S> {
@@ -99,6 +104,9 @@ impl<'m, M: Model> Recorder<'m, M> {
             status: Status::Completed,
             last_good: y0,
             t_last_good: t0,
+            probe_names: model.probe_names().to_vec(),
+            probe_max: vec![f64::NEG_INFINITY; model.probe_names().len()],
+            probe_max_t: vec![t0; model.probe_names().len()],
         };
         traj.t.push(t0);
         traj.states.push(y0);
@@ -106,10 +114,27 @@ impl<'m, M: Model> Recorder<'m, M> {
         traj.booked.push(Work::default());
         traj.supplied.push(0.0);
         traj.dissipated.push(0.0);
-        Self {
+        let mut rec = Self {
             model,
             traj,
             acc: Work::default(),
+        };
+        rec.observe(t0, &y0);
+        rec
+    }
+    /// Update the running maxima of the probed quantities with the state `y` at `t`.
+    pub(crate) fn observe(&mut self, t: f64, y: &M::State) {
+        let n = self.traj.probe_names.len();
+        if n == 0 {
+            return;
+        }
+        let mut v = [0.0; MAX_ACCOUNTS];
+        self.model.probe(t, y, &mut v[..n]);
+        for k in 0..n {
+            if v[k] > self.traj.probe_max[k] {
+                self.traj.probe_max[k] = v[k];
+                self.traj.probe_max_t[k] = t;
+            }
         }
     }
     /// End the run: the state became non-finite during step `step`, which started at `t`.

@@ -75,6 +75,8 @@ pub struct VesselSystem<'a> {
     /// Project after every step onto the invariants the split does not keep (the restoring
     /// invariant `mu = G Qᵀe3`; [`Force::project`]).
     pub project: bool,
+    /// Keep the running maxima of the controller's force and moment over every step.
+    pub extrema: bool,
 }
 
 impl<'a> VesselSystem<'a> {
@@ -103,7 +105,15 @@ impl<'a> VesselSystem<'a> {
             bases,
             origin,
             project: true,
+            extrema: false,
         }
+    }
+
+    /// The same system keeping (or not) the running maxima of the controller's force and
+    /// moment (norms, body frame) over every step ([`Model::probe_names`]).
+    pub fn with_extrema(mut self, extrema: bool) -> Self {
+        self.extrema = extrema;
+        self
     }
 
     /// The same system with (`true`, the default) or without (the paper's scheme as printed)
@@ -437,6 +447,26 @@ impl Model for VesselSystem<'_> {
     /// The restoring invariant `mu − G Qᵀe3` is linear in the state: Runge–Kutta keeps it.
     fn projects_runge_kutta(&self) -> bool {
         false
+    }
+    fn probe_names(&self) -> &[&'static str] {
+        if self.extrema {
+            &["control_force", "control_moment"]
+        } else {
+            &[]
+        }
+    }
+    /// The norms of the controller's force and moment (its P, I and D accounts together).
+    fn probe(&self, t: f64, s: &VesselState, out: &mut [f64]) {
+        let w = self.account_wrenches(s, self.control_on(t));
+        let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
+        for (a, (fa, ma)) in self.accounts.iter().zip(&w) {
+            if a.name == "control" || a.name == "control_damping" {
+                f += fa;
+                m += ma;
+            }
+        }
+        out[0] = f.norm();
+        out[1] = m.norm();
     }
     fn project(&self, s: &mut VesselState) -> Work {
         for f in &self.vessel.forces {

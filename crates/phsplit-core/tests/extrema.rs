@@ -1,0 +1,51 @@
+//! Issue 14: summaries from every step. The running maxima of the controller's force and moment
+//! must equal the maxima over every step's state, also when only every 50th state is saved.
+use phsplit_core::model::vessel::{Vessel, VesselSystem};
+use phsplit_core::settings::Settings;
+use phsplit_core::solve::{run, Model};
+
+#[test]
+fn running_maxima_cover_every_step_whatever_is_saved() {
+    let v = Vessel::paper();
+    for method in ["sp2", "rk4"] {
+        let every = |save_every: usize| {
+            let sys = VesselSystem::new(&v, Some(10.0)).with_extrema(true);
+            let s = Settings {
+                t_span: (0.0, 100.0),
+                h: 0.25,
+                method: method.parse().unwrap(),
+                control_start: Some(10.0),
+                save_every,
+                ..Settings::default()
+            };
+            let tr = run(&sys, &s.method, v.initial_state(), &s.options().unwrap()).unwrap();
+            (sys, tr)
+        };
+        let (sys, all) = every(1);
+        let (_, some) = every(50);
+        // The maxima over every saved state of the run that saves every step, computed here
+        // from the states through the public wrench function.
+        let idx = |name: &str| sys.accounts().iter().position(|a| a.name == name).unwrap();
+        let (c, cd) = (idx("control"), idx("control_damping"));
+        let mut fmax = 0.0f64;
+        let mut mmax = 0.0f64;
+        for (t, s) in all.t.iter().zip(&all.states) {
+            let w = sys.account_wrenches(s, sys.control_on(*t));
+            let f = w[c].0 + w[cd].0;
+            let m = w[c].1 + w[cd].1;
+            fmax = fmax.max(f.norm());
+            mmax = mmax.max(m.norm());
+        }
+        assert_eq!(all.probe_names, ["control_force", "control_moment"]);
+        assert!((all.probe_max[0] - fmax).abs() <= 1e-12 * fmax && (all.probe_max[1] - mmax).abs() <= 1e-12 * mmax);
+        assert_eq!(some.probe_max, all.probe_max, "{method}: saving fewer states loses no peak");
+        // and the peak is larger than what the 50th-step samples show
+        let mut sampled = 0.0f64;
+        for (t, s) in some.t.iter().zip(&some.states) {
+            let w = sys.account_wrenches(s, sys.control_on(*t));
+            sampled = sampled.max((w[c].0 + w[cd].0).norm());
+        }
+        assert!(sampled < all.probe_max[0], "{method}: {sampled} vs {}", all.probe_max[0]);
+        assert!(all.probe_max_t[0] >= 10.0);
+    }
+}
