@@ -154,6 +154,10 @@ CATALOGUE: list[Bad] = [
         E, ("external.point[2]", "within 1000 m")),
     Bad("misspelt external key", vessel_with("[initial]", "[external]\nforse = [1.0, 0.0, 0.0]\n[initial]"), P,
         ("forse", "did you mean 'force'")),
+    Bad("current faster than 10 m/s", vessel_with("[initial]", "[current]\nvelocity = [15.0, 0.0, 0.0]\n[initial]"),
+        E, ("current.velocity[0]", "10 m/s")),
+    Bad("current given as a speed", vessel_with("[initial]", "[current]\nspeed = 1.0\n[initial]"), P,
+        ("speed", "[current]", "velocity")),
     Bad("misspelt component table", vessel_with("[initial]", "[externl]\nforce = [1.0, 0.0, 0.0]\n[initial]"), P,
         ("externl", "did you mean 'external'")),
     # simulation arguments

@@ -52,6 +52,9 @@ class Field:
         if ext:
             self.ext = (np.array(ext.get("force", [0.0] * 3), float), np.array(ext.get("moment", [0.0] * 3), float),
                         np.array(ext.get("point", [0.0] * 3), float), ext.get("frame", "body"))
+        cur = params.get("current")
+        # a uniform current V_c (spatial): the translational damping acts on v - Q^T V_c
+        self.vc = np.array(cur.get("velocity", [0.0] * 3), float) if cur else np.zeros(3)
 
     def external(self, Q):
         """Body-frame force and moment (about the body origin) of the constant external load."""
@@ -76,7 +79,7 @@ class Field:
                         + K["ki_rotational"] @ phth)
         fe, me = self.external(Q)
         dy = np.empty(27)
-        dy[0:3] = -np.cross(w, p) - (self.Dt * v + Q.T @ (self.lam * x) - tau_t) + fe
+        dy[0:3] = -np.cross(w, p) - (self.Dt * (v - Q.T @ self.vc) + Q.T @ (self.lam * x) - tau_t) + fe
         dy[3:6] = -np.cross(w, m) - (self.Dr * w + np.cross(mu, q3) - tau_r) + me
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)

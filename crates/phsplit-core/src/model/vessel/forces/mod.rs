@@ -31,6 +31,7 @@ use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use std::sync::Arc;
 
+pub mod current;
 pub mod damping;
 pub mod external;
 pub mod pid;
@@ -47,6 +48,7 @@ pub const COMPONENTS: &[(&str, &str, Build)] = &[
     ("restoring", "vessel", restoring::build),
     ("pid", "control", pid::build),
     ("external", "external", external::build),
+    ("current", "current", current::build),
 ];
 
 /// The two block systems of flow S2 (paper eq. 41):

@@ -1,0 +1,94 @@
+"""Issue 11 (its first part): a uniform ocean current, through the relative velocity in the
+damping. References: closed forms (steady drift with the current; the integral action that
+holds position against it) and the independent numpy model (tests/reference.py) by DOP853."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import phsplit
+import reference as ref
+
+VC = [0.4, -0.3, 0.0]  # m/s, spatial: towards +x and -y
+
+
+def with_current(velocity=VC):
+    d = phsplit.Vessel.paper().to_dict()
+    d["current"] = {"velocity": list(velocity)}
+    return phsplit.Vessel.from_dict(d)
+
+
+def test_without_control_the_vessel_drifts_with_the_current():
+    """m v' = -D_t (v - Q^T V_c) horizontally: the spatial velocity tends to V_c (time constants
+    mv/D_t = 180 s and 54 s), the heading stays."""
+    v = with_current()
+    s = phsplit.simulate(v, (0.0, 5000.0), 0.5, "sp2", control_start=None, save_every=100)
+    vel = np.einsum("ij,j->i", s.Q[-1], s.v[-1])
+    np.testing.assert_allclose(vel[:2], VC[:2], rtol=0, atol=1e-9)
+    assert s.ledger.by_account["current"][1:].sum() > 0  # the current did work on the vessel
+    assert np.all(s.ledger.relative_residual() < 1e-10)
+
+
+def test_the_controller_holds_position_against_the_current():
+    """At rest at the set point, the integral action balances the current's drag: the
+    controller's spatial force -Ki phi_x cancels the drag Q D_t Q^T V_c, so Ki phi_x equals the
+    drag (x, y), as for a constant external force (test_external.py)."""
+    v = with_current()
+    d = v.to_dict()
+    s = phsplit.simulate(v, (0.0, 8000.0), 1.0, "sp2", control_start=0.0, linear_flow="gauss", save_every=100)
+    ki = np.array(d["control"]["ki_translational"])
+    xr = np.array(d["control"]["position_reference"])
+    # the drag force in the spatial frame: D_t acts in the body frame on the current's components
+    Q = s.Q[-1]
+    drag_spatial = Q @ (np.array(d["vessel"]["damping_translational"]) * (Q.T @ np.array(VC)))
+    np.testing.assert_allclose(ki[:2] * s.phi_x[-1, :2], drag_spatial[:2], rtol=1e-3)
+    assert np.linalg.norm(s.x[-1, :2] - xr[:2]) < 1e-2
+
+
+@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
+def test_orders_with_the_current_against_the_independent_model(method, order):
+    v = with_current()
+    y0 = v.initial_state()
+    y0[0:3] = [2e6, -1e6, 0.0]  # moving, so the relative velocity matters
+    _, y = ref.solve(v.to_dict(), y0, 2.0, 0.0, rtol=1e-13)
+    pe, xe = y[-1][0:3], y[-1][18:21]
+    hs, errs = 2.0 ** -np.arange(1, 6), []
+    for h in hs:
+        s = phsplit.simulate(v, (0.0, 2.0), h, method, control_start=0.0, ledger=False, initial=y0,
+                             project_invariants=False)
+        errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
+    errs = np.array(errs)
+    keep = errs > 1e-13
+    slope = np.polyfit(np.log(hs[keep]), np.log(errs[keep]), 1)[0]
+    assert abs(slope - order) < 0.2, (slope, errs)
+    s = phsplit.simulate(v, (0.0, 2.0), 2.0**-5, method, control_start=0.0, ledger=False, initial=y0)
+    assert np.linalg.norm(s.x[-1] - xe) < 1e-5
+
+
+def test_the_ledger_books_the_current_as_a_port_and_closes():
+    v = with_current()
+    assert ("current", "supplied") in v.accounts
+    for method, lf in (("lie", "exact"), ("sp2", "exact"), ("sp2", "gauss")):
+        s = phsplit.simulate(v, (0.0, 300.0), 0.5, method, control_start=20.0, linear_flow=lf)
+        assert np.all(s.ledger.relative_residual() < 1e-10), (method, lf)
+        assert np.all(s.ledger.dissipated[1:] >= 0)  # positive steps: passive with respect to the ports
+
+
+def test_bad_current_tables():
+    base = phsplit.Vessel.paper().to_dict()
+    for table, words in (({"velocity": [1.0, 2.0]}, "3 numbers"), ({"velocity": [0.0, float("nan"), 0.0]}, "finite"),
+                         ({"velocity": [12.0, 0.0, 0.0]}, "10 m/s"), ({"speed": 1.0}, "unknown field `speed` in \[current\] \(allowed: velocity\)")):
+        d = dict(base, current=table)
+        with pytest.raises(phsplit.InvalidInputError, match=words):
+            phsplit.Vessel.from_dict(d)
+
+
+def test_a_scenario_file_adds_a_current(tmp_path, capsys):
+    from phsplit.cli import main
+
+    sc = tmp_path / "current.toml"
+    sc.write_text('[simulation]\nt_span = [0.0, 60.0]\nh = 0.5\nmethod = "sp2"\n\n[current]\nvelocity = [0.5, 0.0, 0.0]\n')
+    assert phsplit.load_scenario(str(sc)).vessel.components[-1] == "current"
+    assert main(["simulate", str(sc), "--out", str(tmp_path), "--no-plot"]) == 0
+    out = capsys.readouterr().out
+    assert "current supplied" in out and "components: damping, restoring, pid, current" in out
