@@ -113,3 +113,38 @@ def test_dense_output_on_request_is_a_run_stepped_to_each_time():
         np.testing.assert_allclose(d.state(i), r.state(-1), rtol=1e-12, atol=1e-9, err_msg=f"t = {t}")
     with pytest.raises(phsplit.InvalidInputError, match="within the run"):
         s.at([61.0])
+
+
+def test_runge_kutta_runs_cut_into_calls_continue_from_their_own_state():
+    """RK4 lets Q drift off SO(3) by its own error; the calls that continue a run take its state
+    as it is (found by review: they refused it)."""
+    s = phsplit.simulate(V, (0.0, 200.0), 0.5, "rk4", control_start=0.0, save_at=[100.25, 200.0])
+    r = phsplit.simulate(V, (0.0, 100.25), 0.5, "rk4", control_start=0.0)
+    np.testing.assert_array_equal(s.state(0), r.state(-1))
+    full = phsplit.simulate(V, (0.0, 200.0), 0.5, "heun", control_start=0.0, save_every=9)
+    np.testing.assert_allclose(full.at([150.1]).state(0),
+                               phsplit.simulate(V, (0.0, 150.1), 0.5, "heun", control_start=0.0).state(-1),
+                               rtol=1e-12, atol=1e-9)
+    e = phsplit.simulate(V, (0.0, 200.0), 0.5, "rk4", control_start=0.0,
+                         events=[phsplit.events.watch_circle(30.0, direction="enter")])
+    assert e.status == "event"
+
+
+def test_event_on_a_grid_point_and_a_reused_event():
+    stop = phsplit.events.Event("t=600", lambda t, y, v: 600.0 - t, "fall")
+    s = phsplit.simulate(V, (0.0, 1000.0), 0.5, "sp2", control_start=0.0, events=[stop])
+    assert s.status == "event" and abs(s.events[0].t - 600.0) < 1e-9
+    # one event object, two vessels with other set points: each run uses its own
+    ev = phsplit.events.watch_circle(30.0, direction="enter")
+    found = []
+    for ref_x in (700.0, 600.0):
+        d = V.to_dict()
+        d["control"]["position_reference"] = [ref_x, 20.0, 0.0]
+        s = phsplit.simulate(phsplit.Vessel.from_dict(d), (0.0, 60.0), 0.5, "sp2", control_start=0.0, events=ev)
+        found.append(s.events[0].t if s.events else None)
+    assert all(t is not None for t in found) and found[0] != found[1]
+
+
+def test_save_at_on_a_run_that_fails_returns_what_it_has():
+    s = phsplit.simulate(V, (0.0, 20000.0), 40.0, "sp6", control_start=0.0, save_at=[19990.0])
+    assert s.status == "failed" and len(s.t) == 1 and np.all(np.isfinite(s.state(0)))

@@ -155,3 +155,22 @@ def test_plot_draws_the_dp_figure_of_a_file(cli_file, tmp_path):
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
             assert main(["plot", str(path), *args]) == 2
         assert words in err.getvalue() and "Traceback" not in err.getvalue()
+
+
+@pytest.mark.parametrize("args", [["--method", "heun", "--h", "0.05", "--t-end", "1005"],
+                                  ["--method", "lie", "--h", "0.1", "--t-end", "2000.05"]],
+                         ids=["rk-continues", "last-chunk-one-short-step"])
+def test_chunked_runs_complete_and_rerun_bit_for_bit(tmp_path, args):
+    """Found by review: a Runge–Kutta run cut into calls, and a last call holding only the final
+    shorter step, stopped with an error and published a file labelled completed."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(["simulate", "--out", str(tmp_path), "--no-plot", *args]) == 0
+    (path,) = list(tmp_path.glob("*.nc"))
+    with phsplit.open_dataset(path) as ds:
+        assert ds.attrs["status"] == "completed" and float(ds["time"][-1]) == float(args[-1])
+        again = phsplit.rerun(ds)
+        assert phsplit.results.compare(ds, again) == []
+    # a written rerun reruns again
+    again.to_netcdf(tmp_path / "again.nc")
+    with phsplit.open_dataset(tmp_path / "again.nc") as ds2:
+        assert phsplit.results.compare(ds2, phsplit.rerun(ds2)) == []

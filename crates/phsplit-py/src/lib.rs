@@ -309,6 +309,14 @@ fn check_settings<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, api: bool) -> Py
     settings_dict(py, &s, name)
 }
 
+/// A user's flat initial state, checked as `integrate` checks it (and projected to a rotation
+/// when `orthonormalize`); returns the state the core would start from.
+#[pyfunction]
+fn check_state<'py>(py: Python<'py>, state: PyReadonlyArray1<'py, f64>, orthonormalize: bool) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let s = VesselState::from_slice_checked(&entries(&state), orthonormalize).map_err(to_py)?;
+    Ok(PyArray1::from_slice(py, s.to_vector().as_slice()))
+}
+
 /// A mapping of TOML values (tables of numbers, strings, booleans, lists) as TOML text, by
 /// the `toml` crate's writer: phsplit's one TOML writer.
 #[pyfunction]
@@ -382,7 +390,7 @@ impl Monitor for PyMonitor {
 /// released while integrating; signals are checked about every 0.1 s, and Ctrl-C returns what
 /// was computed with status "interrupted". `progress(steps_done, n_steps)` is called as often.
 #[pyfunction]
-#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None, extrema=false))]
+#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None, extrema=false, continuing=false))]
 fn integrate<'py>(
     py: Python<'py>,
     vessel: &PyVessel,
@@ -391,11 +399,13 @@ fn integrate<'py>(
     orthonormalize: bool,
     progress: Option<Py<PyAny>>,
     extrema: bool,
+    continuing: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (settings, _) = settings_of(settings, true)?;
     let opts = settings.options().map_err(to_py)?;
     let y0 = match &state0 {
         None => vessel.inner.initial_state(),
+        Some(a) if continuing => VesselState::from_slice_continuing(&entries(a)).map_err(to_py)?,
         Some(a) => VesselState::from_slice_checked(&entries(a), orthonormalize).map_err(to_py)?,
     };
     let v = vessel.inner.clone();
@@ -605,6 +615,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check_settings, m)?)?;
     m.add_function(wrap_pyfunction!(settings_keys, m)?)?;
     m.add_function(wrap_pyfunction!(dumps_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(check_state, m)?)?;
     m.add_function(wrap_pyfunction!(vessel_tables, m)?)?;
     m.add("METHODS", methods::names())?;
     m.add("OUTER", methods::composition::OUTER_NAMES.to_vec())?;

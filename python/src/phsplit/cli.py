@@ -129,22 +129,27 @@ def _chunks(n: int, save_every: int, target: int = 100, min_steps: int = 20_000)
 
 def _override_suffix(args) -> str:
     """What the command line changed, appended to the output name, so that runs of one scenario
-    with different options do not overwrite each other (fig2-rk4-h0.25.nc)."""
+    with different options do not overwrite each other (fig2-rk4-h0.25.nc). Numbers are written
+    in their shortest exact form, so different values give different names."""
+    import re
+
+    def num(x: float) -> str:
+        s = repr(float(x))
+        return s[:-2] if s.endswith(".0") else s
+
     parts = []
     if args.method:
         parts.append(args.method.lower())
     if args.h is not None:
-        parts.append(f"h{args.h:g}")
+        parts.append(f"h{num(args.h)}")
     if args.t_end is not None:
-        parts.append(f"t{args.t_end:g}")
+        parts.append(f"t{num(args.t_end)}")
     if args.save_every is not None:
         parts.append(f"s{args.save_every}")
     if args.linear_flow is not None:
         parts.append(args.linear_flow)
     if args.control_start is not None:
         parts.append(f"c{args.control_start}")
-    import re
-
     # Only the characters a scenario name may hold (the values were validated before this).
     return "".join("-" + re.sub(r"[^A-Za-z0-9._-]", "_", x) for x in parts)
 
@@ -282,6 +287,9 @@ def _simulate(args) -> int:
                 break
     except KeyboardInterrupt:
         status = "interrupted"
+    except BaseException:
+        status = "failed"  # the file keeps the steps before the error, and says so
+        raise
     finally:
         bar.close()
         with _DeferSignals():
@@ -409,6 +417,10 @@ def _rerun(args) -> int:
     from .results import compare, open_dataset, rerun
 
     ds = open_dataset(args.file)
+    if "time" not in ds.dims:
+        ds.close()
+        raise UsageError(f"{args.file!r} holds no run to repeat (no time dimension; a sweep summary or a case "
+                         "that did not run)")
     try:
         t0 = time.perf_counter()
         print(f"rerunning {args.file}: phsplit {ds.attrs.get('phsplit_version')} {ds.attrs.get('method')} "

@@ -99,10 +99,13 @@ def watch_circle(radius: float, direction: str = "leave", terminal: bool = True)
     r = _positive("watch_circle", "radius (m)", radius)
     if direction not in ("leave", "enter", "both"):
         raise _core.InvalidInputError(f"watch_circle: direction must be 'leave', 'enter' or 'both', got {direction!r}")
-    cache: dict[int, np.ndarray] = {}
+    cache: dict[int, tuple[Any, np.ndarray]] = {}
 
     def g(t, y, vessel):
-        ref = cache.setdefault(id(vessel), _set_point(vessel))
+        hit = cache.get(id(vessel))
+        if hit is None or hit[0] is not vessel:  # the vessel is held, so its id is not reused
+            hit = cache[id(vessel)] = (vessel, _set_point(vessel))
+        ref = hit[1]
         return math.hypot(y[18] - ref[0], y[19] - ref[1]) - r
 
     d = {"leave": "rise", "enter": "fall", "both": "both"}[direction]
@@ -178,9 +181,12 @@ def _booked_steps(sol, names) -> np.ndarray:
 
 
 def _call(vessel, settings, t_a, t_b, h, y, save_every):
+    """One core call of a run cut into several, continuing from the run's own state ``y``."""
     from .simulate import simulate
 
-    return simulate(vessel, initial=y, settings=replace(settings, t_span=(t_a, t_b), h=h, save_every=save_every))
+    h = min(h, t_b - t_a)  # a call of only a last, shorter step
+    return simulate(vessel, initial=y, settings=replace(settings, t_span=(t_a, t_b), h=h, save_every=save_every),
+                    _continuing=True)
 
 
 def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event] = ()):
@@ -218,6 +224,7 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                 steps += g.steps
                 if g.status != "completed":
                     status, failure = g.status, g.failure
+                    rows.add(g, -1, cum)  # the last state before the failure, as plain simulate returns it
                     break
                 y, k = g.last_good_state, kk
             tg = t_at(k)
@@ -284,12 +291,15 @@ def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, 
     best = at(h)
     g_lo, g_hi = ev.g(t_a, y_a, vessel), ev.g(t_a + h, best.state(-1), vessel)
     side = 0
+    # The shortest partial step the times of the run resolve (the core refuses shorter ones).
+    tol = max(1e-12, 1024.0 * np.finfo(float).eps * max(1.0, abs(t_a) + h))
     for _ in range(60):
-        if hi - lo <= 1e-12:
+        if hi - lo <= tol:
             break
         tau = (lo * g_hi - hi * g_lo) / (g_hi - g_lo) if g_hi != g_lo else 0.5 * (lo + hi)
         if not (lo < tau < hi):
             tau = 0.5 * (lo + hi)
+        tau = min(max(tau, tol), h)
         s = at(tau)
         g = ev.g(t_a + tau, s.state(-1), vessel)
         if ev.crosses(g_lo, g):  # the crossing is in [lo, tau]

@@ -56,8 +56,9 @@ def open_dataset(path: str | os.PathLike[str], **kw: Any):
 
 def _need(ds, key: str) -> str:
     if key not in ds.attrs:
-        raise _core.InvalidInputError(f"the file has no {key!r} attribute: it was written by phsplit "
-                                      f"{ds.attrs.get('phsplit_version', '?')}, before files recorded it")
+        raise _core.InvalidInputError(f"the file has no {key!r} attribute, so it does not record how to rerun it "
+                                      "(results of save_at or events come from several runs, and files of "
+                                      f"phsplit before {ds.attrs.get('phsplit_version', '?')} did not record it)")
     return ds.attrs[key]
 
 
@@ -85,7 +86,9 @@ def run_chunks(vessel: Vessel, settings: Settings, state: np.ndarray, chunks: li
     t = t0
     for i, k in enumerate(chunks):
         end = t1 if i == len(chunks) - 1 else t + k * settings.h
-        sol = simulate(vessel, initial=state, settings=replace(settings, t_span=(t, end)))
+        # a last chunk of only the final, shorter step takes that step's length as its h
+        h = min(settings.h, end - t)
+        sol = simulate(vessel, initial=state, settings=replace(settings, t_span=(t, end), h=h), _continuing=True)
         yield sol
         if sol.status != "completed":
             return
@@ -127,7 +130,10 @@ def rerun(source, progress: bool = False):
         chunks, settings = cut, replace(settings, t_span=(settings.t_span[0], t_end))
     sols = list(run_chunks(vessel, settings, y0, chunks))
     out = _joined(sols)
-    out.attrs["status"] = ds.attrs.get("status", sols[-1].status)
+    # The run's own record (the file's), not the first call's: a written rerun reruns again.
+    keep = ("phsplit_settings", "phsplit_chunks", "phsplit_vessel", "phsplit_scenario", "phsplit_scenario_path",
+            "steps", "status")
+    out.attrs.update({k: ds.attrs[k] for k in keep if k in ds.attrs})
     return out
 
 
@@ -143,7 +149,7 @@ def compare(a, b) -> list[tuple[str, float]]:
         x, y = np.asarray(a[name].values), np.asarray(b[name].values)
         if x.shape != y.shape:
             diffs.append((name, float("inf")))
-        elif not np.array_equal(x, y, equal_nan=True):
+        elif not np.array_equal(x, y, equal_nan=x.dtype.kind in "fc" and y.dtype.kind in "fc"):
             with np.errstate(invalid="ignore"):
                 diffs.append((name, float(np.nanmax(np.abs(x.astype(float) - y.astype(float))))))
     return diffs

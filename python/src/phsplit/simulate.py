@@ -246,7 +246,7 @@ class Solution:
         zero = np.zeros(len(names))
         for t in ts:
             i = int(np.searchsorted(self.t, t, side="right")) - 1
-            if self.t[i] == t:
+            if t - self.t[i] <= 1e-12 * max(1.0, abs(t)):  # on a saved time, to round-off
                 p = _call(vessel, base, t, t + self.h, self.h, self.state(i), 1)
                 rows.add(p, 0, zero, t=t)
             else:
@@ -502,6 +502,7 @@ def simulate(
     save_at: Sequence[float] | np.ndarray | None = None,
     events: Sequence[Any] | None = None,
     running_max: bool = False,
+    _continuing: bool = False,
 ) -> Solution:
     """Simulate the vessel with fixed steps ``h`` over ``t_span``.
 
@@ -565,12 +566,16 @@ def simulate(
         if y0.ndim != 1:
             raise _core.InvalidInputError(f"a flat initial state is a 1-D array of {_core.STATE_DIM} numbers, "
                                           f"got shape {y0.shape}")
+    if running_max and (save_at is not None or events):
+        raise _core.InvalidInputError("running_max cannot be combined with save_at or events")
+    if events is not None and not isinstance(events, (list, tuple)):
+        events = [events]  # a single Event
     if save_at is not None or events:
         # Output at chosen times, or events: several core calls (phsplit.events).
         from .events import run_with_outputs
 
-        if orthonormalize and y0 is not None:
-            raise _core.InvalidInputError("orthonormalize cannot be combined with save_at or events")
+        if y0 is not None and not _continuing:
+            y0 = _core.check_state(y0, bool(orthonormalize))  # a user's state: checked once, here
         return run_with_outputs(vessel, settings, y0, save_at=save_at, events=events)
     if progress is True:
         from tqdm import tqdm
@@ -589,7 +594,10 @@ def simulate(
                                       f"got {type(progress).__name__}")
     _warn_if_step_too_long(vessel, y0, settings)
     try:
-        raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), cb, bool(running_max))
+        # _continuing: y0 is the last state of an earlier call of the same run (run_chunks,
+        # save_at, events, Solution.at): taken as it is, only checked to be finite.
+        raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), cb, bool(running_max),
+                              bool(_continuing and y0 is not None))
     finally:
         if bar is not None:
             bar.close()

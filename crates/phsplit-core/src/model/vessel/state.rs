@@ -82,6 +82,26 @@ impl VesselState {
 
     /// A state from a flat vector given by a user: the right length, finite, and with an
     /// attitude that is a rotation (or, with `orthonormalize`, projected to the nearest one).
+    /// A state that continues a run (the last state of an earlier call of the same run): only
+    /// its length and finiteness are checked. An explicit Runge–Kutta method lets `Q` drift off
+    /// SO(3) by its own error, and the continuation must take the state as it is, so that a run
+    /// cut into several calls gives the same numbers as one call.
+    pub fn from_slice_continuing(y: &[f64]) -> Result<Self> {
+        if y.len() != STATE_DIM {
+            return Err(Error::InvalidInput(format!(
+                "a state is a flat vector of {STATE_DIM} numbers, got {}",
+                y.len()
+            )));
+        }
+        if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+            return Err(Error::InvalidInput(format!(
+                "the state to continue from must be finite; entry {i} is {}",
+                y[i]
+            )));
+        }
+        Ok(Self::from_vector(&SVector::<f64, STATE_DIM>::from_column_slice(y)))
+    }
+
     pub fn from_slice_checked(y: &[f64], orthonormalize: bool) -> Result<Self> {
         if y.len() != STATE_DIM {
             return Err(Error::InvalidInput(format!(
