@@ -3,11 +3,11 @@
 //! (or `make bench`); criterion prints the time per call.
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::{Matrix3, Vector3};
-use phsplit_core::lie::elliptic::jacobi;
-use phsplit_core::solve::{run, Options};
-use phsplit_core::methods::{names, Method, Outer};
 use phsplit_core::flows::rigid_body::MagnusOrder;
+use phsplit_core::lie::elliptic::jacobi;
+use phsplit_core::methods::{names, Method, Outer};
 use phsplit_core::model::vessel::{LinearFlow, Vessel, VesselSystem};
+use phsplit_core::solve::{run, Options};
 use std::hint::black_box;
 
 fn flows(c: &mut Criterion) {

@@ -1,12 +1,17 @@
 //! The paper's Fig. 2 scenario with SP4: prints the end state and the ledger closure.
 //! `cargo run --release -p phsplit-core --example fig2 [method] [h]`
-use phsplit_core::solve::{run, Options};
 use phsplit_core::methods::{Method, Outer};
 use phsplit_core::model::vessel::{Vessel, VesselSystem};
+use phsplit_core::solve::{run, Options};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let method = args.get(1).map(String::as_str).unwrap_or("sp4").parse::<Method>().unwrap();
+    let method = args
+        .get(1)
+        .map(String::as_str)
+        .unwrap_or("sp4")
+        .parse::<Method>()
+        .unwrap();
     let h: f64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(0.5);
     let vessel = Vessel::paper();
     let sys = VesselSystem::new(&vessel, Some(50.0));

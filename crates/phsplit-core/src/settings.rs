@@ -52,7 +52,10 @@ pub const KEYS: [(&str, &str); 10] = [
     ("t_span", "two numbers [t0, t1], s"),
     ("h", "step size, s"),
     ("method", "a method name"),
-    ("control_start", "time the controller starts, s, or \"never\""),
+    (
+        "control_start",
+        "time the controller starts, s, or \"never\"",
+    ),
     ("outer", "'dissipative' or 'conservative'"),
     ("save_every", "an integer >= 1"),
     ("linear_flow", "'exact' or 'gauss'"),
@@ -62,7 +65,10 @@ pub const KEYS: [(&str, &str); 10] = [
 ];
 
 fn what(key: &str) -> &'static str {
-    KEYS.iter().find(|(k, _)| *k == key).map(|(_, w)| *w).unwrap_or("")
+    KEYS.iter()
+        .find(|(k, _)| *k == key)
+        .map(|(_, w)| *w)
+        .unwrap_or("")
 }
 
 fn number(key: &str, v: &Value) -> Result<f64> {
@@ -92,7 +98,10 @@ fn string<'a>(key: &str, v: &'a Value) -> Result<&'a str> {
 pub fn check_name(name: &str) -> Result<String> {
     let ok = !name.is_empty()
         && name.len() <= 100
-        && name.chars().next().is_some_and(|c| c.is_ascii_alphanumeric())
+        && name
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphanumeric())
         && name
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-'));
@@ -156,7 +165,12 @@ impl Settings {
                 }
                 "name" => name = Some(check_name(string(key, v)?)?),
                 other => {
-                    return Err(Error::Parse(unknown(other, &valid, "field", "[simulation]")))
+                    return Err(Error::Parse(unknown(
+                        other,
+                        &valid,
+                        "field",
+                        "[simulation]",
+                    )))
                 }
             }
         }
@@ -277,7 +291,11 @@ mod tests {
 
     #[test]
     fn a_span_that_is_not_whole_steps_ends_with_a_shorter_one() {
-        let mut s = Settings { t_span: (0.0, 1.0), h: 0.3, ..Settings::default() };
+        let mut s = Settings {
+            t_span: (0.0, 1.0),
+            h: 0.3,
+            ..Settings::default()
+        };
         let o = s.options().unwrap();
         assert_eq!((o.n_steps, o.h), (4, 0.3));
         assert!((o.last_h - 0.1).abs() < 1e-15);
@@ -293,11 +311,17 @@ mod tests {
             "t_span = [0, 20]\nh = 0.25\nmethod = \"strang\"\ncontrol_start = \"never\"\nname = \"x\"",
         ))
         .unwrap();
-        assert_eq!((s.t_span, s.h, s.method.name(), s.control_start), ((0.0, 20.0), 0.25, "sp2", None));
+        assert_eq!(
+            (s.t_span, s.h, s.method.name(), s.control_start),
+            ((0.0, 20.0), 0.25, "sp2", None)
+        );
         assert_eq!(n.as_deref(), Some("x"));
         for (text, needle) in [
             ("methdo = \"sp2\"", "did you mean 'method'"),
-            ("h = \"fast\"", "simulation.h must be a number (step size, s)"),
+            (
+                "h = \"fast\"",
+                "simulation.h must be a number (step size, s)",
+            ),
             ("t_span = [1.0]", "two numbers"),
             ("method = \"SP4\"", "valid methods"),
             ("save_every = 0", ">= 1"),

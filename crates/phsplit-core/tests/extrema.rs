@@ -37,15 +37,25 @@ fn running_maxima_cover_every_step_whatever_is_saved() {
             mmax = mmax.max(m.norm());
         }
         assert_eq!(all.probe_names, ["control_force", "control_moment"]);
-        assert!((all.probe_max[0] - fmax).abs() <= 1e-12 * fmax && (all.probe_max[1] - mmax).abs() <= 1e-12 * mmax);
-        assert_eq!(some.probe_max, all.probe_max, "{method}: saving fewer states loses no peak");
+        assert!(
+            (all.probe_max[0] - fmax).abs() <= 1e-12 * fmax
+                && (all.probe_max[1] - mmax).abs() <= 1e-12 * mmax
+        );
+        assert_eq!(
+            some.probe_max, all.probe_max,
+            "{method}: saving fewer states loses no peak"
+        );
         // and the peak is larger than what the 50th-step samples show
         let mut sampled = 0.0f64;
         for (t, s) in some.t.iter().zip(&some.states) {
             let w = sys.account_wrenches(s, sys.control_on(*t));
             sampled = sampled.max((w[c].0 + w[cd].0).norm());
         }
-        assert!(sampled < all.probe_max[0], "{method}: {sampled} vs {}", all.probe_max[0]);
+        assert!(
+            sampled < all.probe_max[0],
+            "{method}: {sampled} vs {}",
+            all.probe_max[0]
+        );
         assert!(all.probe_max_t[0] >= 10.0);
     }
 }

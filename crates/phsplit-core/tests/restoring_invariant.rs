@@ -53,7 +53,11 @@ fn at_rest_the_vessel_is_upright_for_every_method_and_step() {
         ("heun", &[0.25]),
         ("euler", &[0.01]), // at 0.05 s its growth factor nearly cancels the roll damping: not at rest by 3600 s
     ];
-    assert_eq!(cases.len(), phsplit_core::methods::REGISTRY.len(), "every registered method");
+    assert_eq!(
+        cases.len(),
+        phsplit_core::methods::REGISTRY.len(),
+        "every registered method"
+    );
     for (method, hs) in cases {
         for &h in hs {
             let (mid, end) = final_state(method, h, 3600.0, true);
@@ -64,18 +68,26 @@ fn at_rest_the_vessel_is_upright_for_every_method_and_step() {
                 e.x,
                 e.y
             );
-            assert!(invariant(&v, &end).norm() <= 1e-9 * invariant_scale(&v), "{method} h={h}");
+            assert!(
+                invariant(&v, &end).norm() <= 1e-9 * invariant_scale(&v),
+                "{method} h={h}"
+            );
             // The roll/pitch integral states have stopped: they moved by less than 1e-9 rad s
             // over the second half hour.
             let d = end.phi_th - mid.phi_th;
-            assert!(d.x.abs() < 1e-9 && d.y.abs() < 1e-9, "{method} h={h}: integral drift {d:?}");
+            assert!(
+                d.x.abs() < 1e-9 && d.y.abs() < 1e-9,
+                "{method} h={h}: integral drift {d:?}"
+            );
         }
     }
 }
 
 fn invariant_scale(v: &Vessel) -> f64 {
     let p = &v.params["vessel"];
-    p["mass"].as_float().unwrap() * p["gravity"].as_float().unwrap() * p["gm_longitudinal"].as_float().unwrap()
+    p["mass"].as_float().unwrap()
+        * p["gravity"].as_float().unwrap()
+        * p["gm_longitudinal"].as_float().unwrap()
 }
 
 #[test]
@@ -85,7 +97,11 @@ fn without_the_projection_the_split_comes_to_rest_tilted() {
     let (_, sp2) = final_state("sp2", 0.2, 3600.0, false);
     assert!(sp2.euler().y.abs() > 1e-6, "pitch {:.3e}", sp2.euler().y);
     let (_, rk4) = final_state("rk4", 0.2, 3600.0, false);
-    assert!(rk4.euler().x.abs() < 1e-12 && rk4.euler().y.abs() < 1e-12, "{:?}", rk4.euler());
+    assert!(
+        rk4.euler().x.abs() < 1e-12 && rk4.euler().y.abs() < 1e-12,
+        "{:?}",
+        rk4.euler()
+    );
 }
 
 #[test]
@@ -97,17 +113,34 @@ fn the_projection_changes_no_energy_and_keeps_the_ledger_closed() {
     s.mu += Vector3::new(3e6, -2e5, 0.0);
     let h0 = sys.energy(&s);
     let booked = sys.project(&mut s);
-    assert_eq!(sys.energy(&s), h0, "H depends only on p, m, mu, x: the projection must not change it");
+    assert_eq!(
+        sys.energy(&s),
+        h0,
+        "H depends only on p, m, mu, x: the projection must not change it"
+    );
     assert!(booked.0.iter().all(|&w| w == 0.0));
-    assert!(invariant(&v, &s).norm() <= 1e-15 * invariant_scale(&v), "{:?}", invariant(&v, &s));
+    assert!(
+        invariant(&v, &s).norm() <= 1e-15 * invariant_scale(&v),
+        "{:?}",
+        invariant(&v, &s)
+    );
     assert!((s.q.transpose() * s.q - nalgebra::Matrix3::identity()).norm() < 1e-15);
     // and in a run with the ledger on, every step closes (SP2, the positive-step method)
-    let st = Settings { t_span: (0.0, 300.0), h: 1.0, method: "sp2".parse().unwrap(), control_start: Some(0.0), ..Settings::default() };
+    let st = Settings {
+        t_span: (0.0, 300.0),
+        h: 1.0,
+        method: "sp2".parse().unwrap(),
+        control_start: Some(0.0),
+        ..Settings::default()
+    };
     let traj = run(&sys, &st.method, v.initial_state(), &st.options().unwrap()).unwrap();
     for k in 1..traj.t.len() {
         let dh = traj.energy[k] - traj.energy[k - 1];
         let bal = traj.supplied[k] - traj.dissipated[k];
         let scale = traj.energy[k - 1].abs() + traj.supplied[k].abs() + traj.dissipated[k].abs();
-        assert!((dh - bal).abs() <= 1e-10 * scale, "step {k}: dH {dh:e}, balance {bal:e}");
+        assert!(
+            (dh - bal).abs() <= 1e-10 * scale,
+            "step {k}: dH {dh:e}, balance {bal:e}"
+        );
     }
 }

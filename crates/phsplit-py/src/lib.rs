@@ -77,7 +77,10 @@ fn to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
     if let Ok(d) = obj.cast::<PyDict>() {
         return Ok(Value::Table(to_table(d, path)?));
     }
-    if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() || obj.hasattr("__array__")? {
+    if obj.is_instance_of::<PyList>()
+        || obj.is_instance_of::<PyTuple>()
+        || obj.hasattr("__array__")?
+    {
         // numpy scalars have __array__ too: a 0-d array is a number.
         if let Ok(x) = obj.extract::<f64>() {
             if !obj.is_instance_of::<PyList>() && !obj.is_instance_of::<PyTuple>() {
@@ -102,10 +105,14 @@ fn to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
 fn to_table(d: &Bound<'_, PyDict>, path: &str) -> PyResult<Table> {
     let mut t = Table::new();
     for (k, v) in d.iter() {
-        let key: String = k
-            .extract()
-            .map_err(|_| InvalidInputError::new_err(format!("the keys of {path} must be strings")))?;
-        let sub = if path.is_empty() { key.clone() } else { format!("{path}.{key}") };
+        let key: String = k.extract().map_err(|_| {
+            InvalidInputError::new_err(format!("the keys of {path} must be strings"))
+        })?;
+        let sub = if path.is_empty() {
+            key.clone()
+        } else {
+            format!("{path}.{key}")
+        };
         t.insert(key, to_toml(&v, &sub)?);
     }
     Ok(t)
@@ -169,7 +176,8 @@ impl PyVessel {
     /// Every parameter as read, as TOML text (the `toml` crate's writer; floats in their
     /// shortest round-trip form, so `from_toml_str(to_toml())` rebuilds the vessel exactly).
     fn to_toml(&self) -> PyResult<String> {
-        toml::to_string(&self.inner.params).map_err(|e| PhsplitError::new_err(format!("cannot write TOML: {e}")))
+        toml::to_string(&self.inner.params)
+            .map_err(|e| PhsplitError::new_err(format!("cannot write TOML: {e}")))
     }
     /// The TOML text of the paper's vessel, with its provenance.
     #[staticmethod]
@@ -197,7 +205,11 @@ impl PyVessel {
     /// the attitude of a flat 27-vector `state`, with the controller on or off
     /// (`VesselSystem::natural_periods`).
     #[pyo3(signature = (state, control))]
-    fn natural_periods(&self, state: PyReadonlyArray1<'_, f64>, control: bool) -> PyResult<Vec<f64>> {
+    fn natural_periods(
+        &self,
+        state: PyReadonlyArray1<'_, f64>,
+        control: bool,
+    ) -> PyResult<Vec<f64>> {
         let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;
         Ok(VesselSystem::new(&self.inner, None).natural_periods(&s.q, control))
     }
@@ -222,7 +234,11 @@ impl PyVessel {
             ("euler", euler.unwrap_or(i.euler), "rad"),
             ("position", position.unwrap_or(i.position), "m"),
             ("velocity", velocity.unwrap_or(i.velocity), "m/s"),
-            ("angular_velocity", angular_velocity.unwrap_or(i.angular_velocity), "rad/s"),
+            (
+                "angular_velocity",
+                angular_velocity.unwrap_or(i.angular_velocity),
+                "rad/s",
+            ),
         ];
         for (name, v, unit) in &all {
             if v.iter().any(|x| !x.is_finite()) {
@@ -274,7 +290,11 @@ fn settings_of(d: &Bound<'_, PyDict>, api: bool) -> PyResult<(Settings, Option<S
     })
 }
 
-fn settings_dict<'py>(py: Python<'py>, s: &Settings, name: Option<String>) -> PyResult<Bound<'py, PyDict>> {
+fn settings_dict<'py>(
+    py: Python<'py>,
+    s: &Settings,
+    name: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("t_span", (s.t_span.0, s.t_span.1))?;
     d.set_item("h", s.h)?;
@@ -304,7 +324,11 @@ fn default_settings(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 /// with the step count. `api=False` reads a scenario file's [simulation] table.
 #[pyfunction]
 #[pyo3(signature = (d, api=true))]
-fn check_settings<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, api: bool) -> PyResult<Bound<'py, PyDict>> {
+fn check_settings<'py>(
+    py: Python<'py>,
+    d: &Bound<'py, PyDict>,
+    api: bool,
+) -> PyResult<Bound<'py, PyDict>> {
     let (s, name) = settings_of(d, api)?;
     settings_dict(py, &s, name)
 }
@@ -312,7 +336,11 @@ fn check_settings<'py>(py: Python<'py>, d: &Bound<'py, PyDict>, api: bool) -> Py
 /// A user's flat initial state, checked as `integrate` checks it (and projected to a rotation
 /// when `orthonormalize`); returns the state the core would start from.
 #[pyfunction]
-fn check_state<'py>(py: Python<'py>, state: PyReadonlyArray1<'py, f64>, orthonormalize: bool) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn check_state<'py>(
+    py: Python<'py>,
+    state: PyReadonlyArray1<'py, f64>,
+    orthonormalize: bool,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let s = VesselState::from_slice_checked(&entries(&state), orthonormalize).map_err(to_py)?;
     Ok(PyArray1::from_slice(py, s.to_vector().as_slice()))
 }
@@ -345,8 +373,14 @@ fn method_info<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>>
     d.set_item("kind", m.kind())?;
     d.set_item("subflow_order", m.subflow_order())?;
     if let Method::Splitting(c) = &m {
-        d.set_item("dissipation_ratio_bound_outer", c.dissipation_ratio_bound(true))?;
-        d.set_item("dissipation_ratio_bound_inner", c.dissipation_ratio_bound(false))?;
+        d.set_item(
+            "dissipation_ratio_bound_outer",
+            c.dissipation_ratio_bound(true),
+        )?;
+        d.set_item(
+            "dissipation_ratio_bound_inner",
+            c.dissipation_ratio_bound(false),
+        )?;
     }
     Ok(d)
 }
@@ -475,15 +509,24 @@ fn integrate<'py>(
     let d = PyDict::new(py);
     let arr3 = |v: &Vec<f64>| PyArray1::from_slice(py, v).reshape([n, 3]);
     d.set_item("t", PyArray1::from_vec(py, traj.t.clone()))?;
-    for (i, name) in ["p", "m", "mu", "x", "phi_th", "phi_x", "euler"].iter().enumerate() {
+    for (i, name) in ["p", "m", "mu", "x", "phi_th", "phi_x", "euler"]
+        .iter()
+        .enumerate()
+    {
         d.set_item(*name, arr3(&cols[i])?)?;
     }
-    d.set_item("orthogonality_defect", PyArray1::from_vec(py, cols[7].clone()))?;
+    d.set_item(
+        "orthogonality_defect",
+        PyArray1::from_vec(py, cols[7].clone()),
+    )?;
     d.set_item("Q", PyArray1::from_vec(py, qmat).reshape([n, 3, 3])?)?;
     d.set_item("quaternion", PyArray1::from_vec(py, quat).reshape([n, 4])?)?;
     d.set_item("energy", PyArray1::from_vec(py, traj.energy.clone()))?;
     d.set_item("supplied", PyArray1::from_vec(py, traj.supplied.clone()))?;
-    d.set_item("dissipated", PyArray1::from_vec(py, traj.dissipated.clone()))?;
+    d.set_item(
+        "dissipated",
+        PyArray1::from_vec(py, traj.dissipated.clone()),
+    )?;
     let names: Vec<&str> = traj.accounts.iter().map(|a| a.name).collect();
     let kinds: Vec<&str> = traj.accounts.iter().map(|a| kind_name(a.kind)).collect();
     d.set_item("accounts", names)?;
@@ -498,10 +541,19 @@ fn integrate<'py>(
             moment.extend_from_slice(m.as_slice());
         }
     }
-    d.set_item("account_force", PyArray1::from_vec(py, force).reshape([n, k, 3])?)?;
-    d.set_item("account_moment", PyArray1::from_vec(py, moment).reshape([n, k, 3])?)?;
+    d.set_item(
+        "account_force",
+        PyArray1::from_vec(py, force).reshape([n, k, 3])?,
+    )?;
+    d.set_item(
+        "account_moment",
+        PyArray1::from_vec(py, moment).reshape([n, k, 3])?,
+    )?;
     d.set_item("steps", traj.steps)?;
-    d.set_item("last_good", PyArray1::from_slice(py, traj.last_good.to_vector().as_slice()))?;
+    d.set_item(
+        "last_good",
+        PyArray1::from_slice(py, traj.last_good.to_vector().as_slice()),
+    )?;
     d.set_item("t_last_good", traj.t_last_good)?;
     let ext = PyDict::new(py);
     for (k, name) in traj.probe_names.iter().enumerate() {
@@ -517,7 +569,10 @@ fn integrate<'py>(
         }
         Status::Interrupted { step, t } => {
             d.set_item("status", "interrupted")?;
-            d.set_item("failure", format!("interrupted after step {step} (t = {t})"))?;
+            d.set_item(
+                "failure",
+                format!("interrupted after step {step} (t = {t})"),
+            )?;
         }
     }
     Ok(d)
@@ -575,7 +630,11 @@ impl PyVectorField {
 
 impl PyVectorField {
     /// The field at a 27-vector, without the finiteness check (solvers probe freely).
-    fn field(&self, t: f64, y: &PyReadonlyArray1<'_, f64>) -> PyResult<nalgebra::SVector<f64, STATE_DIM>> {
+    fn field(
+        &self,
+        t: f64,
+        y: &PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<nalgebra::SVector<f64, STATE_DIM>> {
         let s = entries(y);
         if s.len() != STATE_DIM {
             return Err(InvalidInputError::new_err(format!(
@@ -583,7 +642,8 @@ impl PyVectorField {
                 s.len()
             )));
         }
-        let s = VesselState::from_vector(&nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(&s));
+        let s =
+            VesselState::from_vector(&nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(&s));
         let sys = VesselSystem::new(&self.vessel, self.control_start);
         Ok(sys.vector_field(&s, sys.control_on(t)).to_vector())
     }
@@ -619,12 +679,18 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vessel_tables, m)?)?;
     m.add("METHODS", methods::names())?;
     m.add("OUTER", methods::composition::OUTER_NAMES.to_vec())?;
-    m.add("LINEAR_FLOWS", vec![LinearFlow::Exact.name(), LinearFlow::Gauss.name()])?;
+    m.add(
+        "LINEAR_FLOWS",
+        vec![LinearFlow::Exact.name(), LinearFlow::Gauss.name()],
+    )?;
     m.add("MAX_STEPS", phsplit_core::solve::MAX_STEPS)?;
     m.add("STATE_DIM", STATE_DIM)?;
     m.add("PhsplitError", m.py().get_type::<PhsplitError>())?;
     m.add("InvalidInputError", m.py().get_type::<InvalidInputError>())?;
-    m.add("ScenarioParseError", m.py().get_type::<ScenarioParseError>())?;
+    m.add(
+        "ScenarioParseError",
+        m.py().get_type::<ScenarioParseError>(),
+    )?;
     m.add("IntegrationError", m.py().get_type::<IntegrationError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -3,8 +3,8 @@
 //! port-Hamiltonian linear system it conserves the storage exactly where the system does and
 //! dissipates it where the system does (algebraic stability; paper Remark 2.3).
 
-use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use nalgebra::{Complex, ComplexField, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use std::sync::OnceLock;
 
 /// Butcher coefficients `(A, b)` of the `s`-stage Gauss method, in the leading `s × s`
@@ -188,8 +188,7 @@ impl Blocks {
     /// The blocks of a 10×10 augmented matrix, if it has this structure (the other
     /// entries zero).
     pub fn from_augmented(a: &SMatrix<f64, 10, 10>) -> Option<Self> {
-        let blk =
-            |r: usize, c: usize| -> Matrix3<f64> { a.fixed_view::<3, 3>(r, c).into_owned() };
+        let blk = |r: usize, c: usize| -> Matrix3<f64> { a.fixed_view::<3, 3>(r, c).into_owned() };
         let col = |r: usize| -> Vector3<f64> { a.fixed_view::<3, 1>(r, 9).into_owned() };
         let zero3 = |m: Matrix3<f64>| m.iter().all(|v| *v == 0.0);
         let ok = zero3(blk(3, 3))
@@ -369,9 +368,8 @@ pub fn blocks_step(sys: &Blocks, z0: &Z3, h: f64, s: usize) -> Option<(Z3, [Z3; 
     let g2 = sys.auw * fw0 + sys.auv * avu_u0;
     let g3 = sys.auw * awv_avu_u0;
     let (h2, h3) = (h * h, h * h * h);
-    let rhs = |i: usize| {
-        g1 * (h * tr.pow1[0][i]) + g2 * (h2 * tr.pow1[1][i]) + g3 * (h3 * tr.pow1[2][i])
-    };
+    let rhs =
+        |i: usize| g1 * (h * tr.pow1[0][i]) + g2 * (h2 * tr.pow1[1][i]) + g3 * (h3 * tr.pow1[2][i]);
     let r = [rhs(0), rhs(1), rhs(2)];
     let p3 = if cubic {
         sys.auw * (sys.awv * sys.avu)
@@ -563,5 +561,4 @@ mod tests {
         b[(4, 4)] = 1.0;
         assert!(structured(&b, &z0, 0.5, 1).is_none());
     }
-
 }

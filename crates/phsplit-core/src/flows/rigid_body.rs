@@ -28,8 +28,8 @@
 //! §3.4.1 with the signs of docs/model.md §3: for `Q' = Q A(t)` every even-degree commutator term
 //! changes sign relative to the printed `Y' = A(t) Y` formulas).
 
-use crate::lie::elliptic::{ellipf_scd, ellipk_m1, jacobi_m1};
 use crate::error::{Error, Result};
+use crate::lie::elliptic::{ellipf_scd, ellipk_m1, jacobi_m1};
 use crate::lie::so3;
 use nalgebra::{Matrix3, Vector3};
 
@@ -236,7 +236,9 @@ impl FreeRigidBody {
                         // Nodes 1/2 ∓ r from (sn, cn, dn) at 1/2 and at r: two evaluations.
                         let r = 15f64.sqrt() / 10.0;
                         let (a2, ar) = (adv(0.5), adv(r));
-                        let a1 = a2.add(&ar.neg(), o.k2, o.k1).unwrap_or_else(|| adv(0.5 - r));
+                        let a1 = a2
+                            .add(&ar.neg(), o.k2, o.k1)
+                            .unwrap_or_else(|| adv(0.5 - r));
                         let a3 = a2.add(&ar, o.k2, o.k1).unwrap_or_else(|| adv(0.5 + r));
                         let e = end(&a2, &a2, 1.0);
                         (
@@ -740,17 +742,62 @@ mod tests {
         // (m0, t, m(t), the solution's own sensitivity to one ulp in any input)
         let cases: [([f64; 3], f64, [f64; 3], f64); 7] = [
             // the input
-            ([1e-7, 1.0, 2e-7], 0.5, [8.431887902349233e-8, 1.0000000000000058, 1.7700005672127622e-7], 2.2e-16),
-            ([1e-7, 1.0, 2e-7], 5.0, [-7.318189973321318e-9, 1.00000000000002, 1.0080013746745022e-7], 2.2e-16),
-            ([1e-7, 1.0, 2e-7], 50.0, [-0.014350705855544625, 0.9995880296231195, 0.02485615166648064], 2.4e-16),
+            (
+                [1e-7, 1.0, 2e-7],
+                0.5,
+                [
+                    8.431887902349233e-8,
+                    1.0000000000000058,
+                    1.7700005672127622e-7,
+                ],
+                2.2e-16,
+            ),
+            (
+                [1e-7, 1.0, 2e-7],
+                5.0,
+                [
+                    -7.318189973321318e-9,
+                    1.00000000000002,
+                    1.0080013746745022e-7,
+                ],
+                2.2e-16,
+            ),
+            (
+                [1e-7, 1.0, 2e-7],
+                50.0,
+                [
+                    -0.014350705855544625,
+                    0.9995880296231195,
+                    0.02485615166648064,
+                ],
+                2.4e-16,
+            ),
             // around it: the other side of the separatrix (k² from the other case), m_mid < 0
-            ([2e-7, -1.0, 1e-7], 0.5, [2.1044925141844245e-7, -0.9999999999999915, 1.5121726841782456e-7], 2.2e-16),
-            ([2e-7, -1.0, 1e-7], 50.0, [0.2262002088408769, -0.8918149259131822, 0.3917902543949492], 1.5e-15),
+            (
+                [2e-7, -1.0, 1e-7],
+                0.5,
+                [
+                    2.1044925141844245e-7,
+                    -0.9999999999999915,
+                    1.5121726841782456e-7,
+                ],
+                2.2e-16,
+            ),
+            (
+                [2e-7, -1.0, 1e-7],
+                50.0,
+                [0.2262002088408769, -0.8918149259131822, 0.3917902543949492],
+                1.5e-15,
+            ),
             // within 1e-9 of the separatrix as well as next to the axis
             (
                 [1e-7, 1.0, 5.7735026976697607e-8],
                 30.0,
-                [0.00019230000503864445, 0.9999999260414334, -0.00033307333899146204],
+                [
+                    0.00019230000503864445,
+                    0.9999999260414334,
+                    -0.00033307333899146204,
+                ],
                 2.2e-16,
             ),
             ([1e-7, 1.0, 2e-7], 0.0, [1e-7, 1.0, 2e-7], 0.0),
@@ -759,18 +806,30 @@ mod tests {
             let (m0, want) = (Vector3::from(m0), Vector3::from(want));
             let bound = 4.0 * sens.max(f64::EPSILON * m0.norm());
             let orbit = body.orbit(&m0);
-            for (path, m) in [("addition", orbit.momentum(t)), ("direct", orbit.momentum_direct(t))] {
+            for (path, m) in [
+                ("addition", orbit.momentum(t)),
+                ("direct", orbit.momentum_direct(t)),
+            ] {
                 let err = (m - want).norm();
                 assert!(err <= bound, "{m0:?} t={t} ({path}): {m:?}, error {err:e}");
             }
             for order in [MagnusOrder::Two, MagnusOrder::Six] {
                 let (m, _) = body.flow(&m0, &Matrix3::identity(), t, order);
-                assert!((m - want).norm() <= bound, "{m0:?} t={t} flow {order:?}: {m:?}");
+                assert!(
+                    (m - want).norm() <= bound,
+                    "{m0:?} t={t} flow {order:?}: {m:?}"
+                );
             }
         }
         // k'² itself, to round-off: 1 − k² = |J1 − J3| (m3² |J2 − J3| − m1² |J1 − J2|) / den.
-        let k1 = body.orbit(&Vector3::new(1e-7, 1.0, 2e-7)).complementary_parameter().unwrap();
-        assert!((k1 - 1.3333333333332621e-14).abs() <= 4.0 * f64::EPSILON * k1, "k'² = {k1:e}");
+        let k1 = body
+            .orbit(&Vector3::new(1e-7, 1.0, 2e-7))
+            .complementary_parameter()
+            .unwrap();
+        assert!(
+            (k1 - 1.3333333333332621e-14).abs() <= 4.0 * f64::EPSILON * k1,
+            "k'² = {k1:e}"
+        );
     }
 
     #[test]
@@ -779,16 +838,25 @@ mod tests {
         // components are ~1e-149 of |m|, so k² rounds to 1 and sn ν to 1: the direct phase
         // F(π/2 | 1) is infinite. The exact solution leaves the axis like e^{λt} · 1e-149.
         let body = FreeRigidBody::new(Vector3::new(1.4365355e8, 1.022303625e10, 3.9875e9)).unwrap();
-        let m0 = Vector3::new(7.493675271476608e-142, -9.589185400761611e-141, 290756659.433808);
+        let m0 = Vector3::new(
+            7.493675271476608e-142,
+            -9.589185400761611e-141,
+            290756659.433808,
+        );
         for order in [MagnusOrder::Two, MagnusOrder::Four, MagnusOrder::Six] {
             for t in [0.5, 3.0, 30.0, -3.0] {
                 let (m1, q1) = body.flow(&m0, &Matrix3::identity(), t, order);
                 assert!(m1.iter().all(|v| v.is_finite()), "{order:?} t={t}: {m1:?}");
-                assert!((m1 - m0).norm() <= 1e-12 * m0.norm(), "{order:?} t={t}: {m1:?}");
+                assert!(
+                    (m1 - m0).norm() <= 1e-12 * m0.norm(),
+                    "{order:?} t={t}: {m1:?}"
+                );
                 assert!(so3::orthogonality_defect(&q1) < 1e-14);
                 // a rotation about yaw at rate m_z / T_z
                 let angle = so3::log(&q1).z;
-                let expect = (m0.z / 3.9875e9 * t + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+                let expect = (m0.z / 3.9875e9 * t + std::f64::consts::PI)
+                    .rem_euclid(2.0 * std::f64::consts::PI)
+                    - std::f64::consts::PI;
                 assert!((angle - expect).abs() < 1e-12, "{angle} vs {expect}");
             }
         }

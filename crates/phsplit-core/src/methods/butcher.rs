@@ -51,4 +51,3 @@ impl ButcherTableau {
         self.b.len()
     }
 }
-

@@ -239,4 +239,3 @@ fn merge(raw: Vec<(bool, f64)>) -> Vec<(bool, f64)> {
     }
     out
 }
-

@@ -65,7 +65,12 @@ pub fn run_splitting_watched<M: SplitModel>(
                     }
                 }
             }
-            if i == last && fsal && !saves_after(n, opts) && model.same_field(t, t1) && !model.projects() {
+            if i == last
+                && fsal
+                && !saves_after(n, opts)
+                && model.same_field(t, t1)
+                && !model.projects()
+            {
                 pending = Some((flow, len, t));
                 continue;
             }
@@ -219,8 +224,14 @@ mod tests {
         growth: Option<f64>,
     }
     const ACC: [Account; 2] = [
-        Account { name: "input", kind: AccountKind::Supplied },
-        Account { name: "damping", kind: AccountKind::Dissipated },
+        Account {
+            name: "input",
+            kind: AccountKind::Supplied,
+        },
+        Account {
+            name: "damping",
+            kind: AccountKind::Dissipated,
+        },
     ];
 
     impl Model for Osc {
@@ -244,7 +255,15 @@ mod tests {
             assert!(order <= 6);
             Ok(())
         }
-        fn flow(&self, which: Flow, h: f64, _t: f64, _o: usize, ledger: bool, s: &mut [f64; 2]) -> Work {
+        fn flow(
+            &self,
+            which: Flow,
+            h: f64,
+            _t: f64,
+            _o: usize,
+            ledger: bool,
+            s: &mut [f64; 2],
+        ) -> Work {
             let mut w = Work::default();
             match which {
                 Flow::S1 => {
@@ -261,7 +280,8 @@ mod tests {
                     let e = (-D * h).exp();
                     if ledger {
                         let int_p = pe * h + a * (1.0 - e) / D;
-                        let int_p2 = pe * pe * h + 2.0 * pe * a * (1.0 - e) / D
+                        let int_p2 = pe * pe * h
+                            + 2.0 * pe * a * (1.0 - e) / D
                             + a * a * (1.0 - e * e) / (2.0 * D);
                         w.0[0] = U * int_p;
                         w.0[1] = D * int_p2;
@@ -282,7 +302,10 @@ mod tests {
         }
         fn rhs(&self, _t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
             let g = self.growth.map_or(-D, |g| g);
-            SVector::<f64, 2>::new(y[1], -y[0] + g * y[1] + if self.growth.is_some() { 0.0 } else { U })
+            SVector::<f64, 2>::new(
+                y[1],
+                -y[0] + g * y[1] + if self.growth.is_some() { 0.0 } else { U },
+            )
         }
         fn power(&self, _t: f64, y: &SVector<f64, 2>) -> Work {
             let mut w = Work::default();
@@ -305,7 +328,10 @@ mod tests {
     }
 
     fn opts(h: f64, n: usize, save_every: usize, outer: Outer) -> Options {
-        Options { outer, ..Options::steps(0.0, h, n, save_every) }
+        Options {
+            outer,
+            ..Options::steps(0.0, h, n, save_every)
+        }
     }
 
     #[test]
@@ -333,9 +359,16 @@ mod tests {
                     .filter(|(_, e)| **e > 1e-13)
                     .map(|(h, e)| (h.ln(), e.ln()))
                     .collect();
-                assert!(pts.len() >= 3, "{}: too few points above round-off: {errs:?}", entry.name);
+                assert!(
+                    pts.len() >= 3,
+                    "{}: too few points above round-off: {errs:?}",
+                    entry.name
+                );
                 let n = pts.len() as f64;
-                let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+                let (mx, my) = (
+                    pts.iter().map(|p| p.0).sum::<f64>() / n,
+                    pts.iter().map(|p| p.1).sum::<f64>() / n,
+                );
                 let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
                     / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
                 assert!(
@@ -354,13 +387,32 @@ mod tests {
         for name in ["lie", "sp2", "sp4", "sp6"] {
             let m: Method = name.parse().unwrap();
             for outer in [Outer::Dissipative, Outer::Conservative] {
-                let a = run(&Osc { growth: None }, &m, [1.0, 0.2], &opts(0.1, 50, 1, outer)).unwrap();
-                let b = run(&Osc { growth: None }, &m, [1.0, 0.2], &opts(0.1, 50, 50, outer)).unwrap();
+                let a = run(
+                    &Osc { growth: None },
+                    &m,
+                    [1.0, 0.2],
+                    &opts(0.1, 50, 1, outer),
+                )
+                .unwrap();
+                let b = run(
+                    &Osc { growth: None },
+                    &m,
+                    [1.0, 0.2],
+                    &opts(0.1, 50, 50, outer),
+                )
+                .unwrap();
                 let (ya, yb) = (a.states.last().unwrap(), b.states.last().unwrap());
-                assert!((ya[0] - yb[0]).abs() < 1e-13 && (ya[1] - yb[1]).abs() < 1e-13, "{name}");
+                assert!(
+                    (ya[0] - yb[0]).abs() < 1e-13 && (ya[1] - yb[1]).abs() < 1e-13,
+                    "{name}"
+                );
                 // The ledger adds up the same.
                 let sa: f64 = a.supplied.iter().sum();
-                assert!((sa - b.supplied[1]).abs() < 1e-13, "{name}: {sa} vs {}", b.supplied[1]);
+                assert!(
+                    (sa - b.supplied[1]).abs() < 1e-13,
+                    "{name}: {sa} vs {}",
+                    b.supplied[1]
+                );
             }
         }
     }
@@ -368,7 +420,13 @@ mod tests {
     #[test]
     fn saving_and_the_ledger() {
         let m: Method = "sp2".parse().unwrap();
-        let tr = run(&Osc { growth: None }, &m, [1.0, 0.0], &opts(0.1, 10, 3, Outer::Dissipative)).unwrap();
+        let tr = run(
+            &Osc { growth: None },
+            &m,
+            [1.0, 0.0],
+            &opts(0.1, 10, 3, Outer::Dissipative),
+        )
+        .unwrap();
         // Steps 3, 6, 9 and the last (10) are saved, after the initial state.
         let t: Vec<f64> = tr.t.iter().map(|t| (t * 10.0).round()).collect();
         assert_eq!(t, [0.0, 3.0, 6.0, 9.0, 10.0]);
@@ -390,7 +448,9 @@ mod tests {
         for name in ["sp2", "rk4"] {
             let m: Method = name.parse().unwrap();
             let tr = run(&osc, &m, [1.0, 1.0], &opts(1.0, 400, 1, Outer::Dissipative)).unwrap();
-            let Status::Failed { step, .. } = tr.status else { panic!("{name} did not fail") };
+            let Status::Failed { step, .. } = tr.status else {
+                panic!("{name} did not fail")
+            };
             assert!(step > 0 && step < 400, "{name}: {step}");
             assert_eq!(tr.steps, step);
             assert!(tr.states.iter().all(|s| s.iter().all(|v| v.is_finite())));
@@ -398,7 +458,12 @@ mod tests {
             assert_eq!(tr.t.len(), step + 1);
         }
         // Bad options are refused before the first step.
-        let e = run(&Osc { growth: None }, &"sp2".parse().unwrap(), [0.0; 2], &opts(0.0, 1, 1, Outer::Dissipative));
+        let e = run(
+            &Osc { growth: None },
+            &"sp2".parse().unwrap(),
+            [0.0; 2],
+            &opts(0.0, 1, 1, Outer::Dissipative),
+        );
         assert!(e.unwrap_err().to_string().contains("h must be"));
     }
 
@@ -417,14 +482,31 @@ mod tests {
             // save_every 5: the composition defers (merges) its last sub-step across unsaved
             // boundaries; the interrupt must complete the step first.
             let o = opts(0.1, 50, 5, Outer::Dissipative);
-            let tr = run_watched(&Osc { growth: None }, &m, [1.0, 0.2], &o, &mut StopAfter(7)).unwrap();
-            assert_eq!(tr.status, Status::Interrupted { step: 7, t: 0.7000000000000001 }, "{name}");
+            let tr =
+                run_watched(&Osc { growth: None }, &m, [1.0, 0.2], &o, &mut StopAfter(7)).unwrap();
+            assert_eq!(
+                tr.status,
+                Status::Interrupted {
+                    step: 7,
+                    t: 0.7000000000000001
+                },
+                "{name}"
+            );
             assert_eq!(tr.steps, 7);
             let t: Vec<f64> = tr.t.iter().map(|t| (t * 10.0).round()).collect();
             assert_eq!(t, [0.0, 5.0, 7.0], "{name}");
-            let full = run(&Osc { growth: None }, &m, [1.0, 0.2], &opts(0.1, 7, 1, Outer::Dissipative)).unwrap();
+            let full = run(
+                &Osc { growth: None },
+                &m,
+                [1.0, 0.2],
+                &opts(0.1, 7, 1, Outer::Dissipative),
+            )
+            .unwrap();
             let (a, b) = (tr.states.last().unwrap(), full.states.last().unwrap());
-            assert!((a[0] - b[0]).abs() < 1e-14 && (a[1] - b[1]).abs() < 1e-14, "{name}: {a:?} vs {b:?}");
+            assert!(
+                (a[0] - b[0]).abs() < 1e-14 && (a[1] - b[1]).abs() < 1e-14,
+                "{name}: {a:?} vs {b:?}"
+            );
             assert_eq!(tr.last_good, *a);
             // the ledger of the interrupted run closes as the completed one's
             let sa: f64 = tr.supplied.iter().sum();
@@ -469,7 +551,15 @@ mod tests {
         fn supports_order(&self, order: usize) -> Result<()> {
             self.inner.supports_order(order)
         }
-        fn flow(&self, which: Flow, h: f64, t: f64, o: usize, ledger: bool, s: &mut [f64; 2]) -> Work {
+        fn flow(
+            &self,
+            which: Flow,
+            h: f64,
+            t: f64,
+            o: usize,
+            ledger: bool,
+            s: &mut [f64; 2],
+        ) -> Work {
             self.inner.flow(which, h, t, o, ledger, s)
         }
     }
@@ -493,8 +583,17 @@ mod tests {
         for name in ["sp2", "sp4", "lie", "rk4"] {
             let m: Method = name.parse().unwrap();
             let run_with = |save_every: usize| {
-                let pm = Projected { inner: Osc { growth: None }, calls: std::cell::Cell::new(0) };
-                let tr = run(&pm, &m, [1.0, 0.2], &opts(0.1, 20, save_every, Outer::Dissipative)).unwrap();
+                let pm = Projected {
+                    inner: Osc { growth: None },
+                    calls: std::cell::Cell::new(0),
+                };
+                let tr = run(
+                    &pm,
+                    &m,
+                    [1.0, 0.2],
+                    &opts(0.1, 20, save_every, Outer::Dissipative),
+                )
+                .unwrap();
                 (tr, pm.calls.get())
             };
             let (a, calls_a) = run_with(1);
@@ -520,13 +619,23 @@ mod tests {
         let ex = exact(1.0, [1.0, -0.5]);
         for name in ["sp2", "sp4", "rk4", "lie"] {
             let m: Method = name.parse().unwrap();
-            let o = Options { last_h: 0.1, ..opts(0.3, 4, 1, Outer::Dissipative) };
+            let o = Options {
+                last_h: 0.1,
+                ..opts(0.3, 4, 1, Outer::Dissipative)
+            };
             let tr = run(&Osc { growth: None }, &m, [1.0, -0.5], &o).unwrap();
-            assert!((tr.t.last().unwrap() - 1.0).abs() < 1e-15, "{name}: {:?}", tr.t);
+            assert!(
+                (tr.t.last().unwrap() - 1.0).abs() < 1e-15,
+                "{name}: {:?}",
+                tr.t
+            );
             let y = tr.states.last().unwrap();
             let err = ((y[0] - ex[0]).powi(2) + (y[1] - ex[1]).powi(2)).sqrt();
             // the local errors of a method of order p at h = 0.3: far below 0.3^p... but not 0
-            assert!(err < 0.3f64.powi(m.order() as i32) && err > 0.0, "{name}: {err}");
+            assert!(
+                err < 0.3f64.powi(m.order() as i32) && err > 0.0,
+                "{name}: {err}"
+            );
         }
     }
 }

@@ -86,7 +86,10 @@ impl Options {
             )));
         }
         // Every step must advance the time: h above the resolution of t over the run.
-        let t_max = self.t0.abs().max((self.t0 + self.n_steps as f64 * self.h).abs());
+        let t_max = self
+            .t0
+            .abs()
+            .max((self.t0 + self.n_steps as f64 * self.h).abs());
         let ulp = t_max * f64::EPSILON;
         if self.last_h <= 4.0 * ulp || self.h <= 64.0 * ulp {
             return Err(Error::InvalidInput(format!(

@@ -16,7 +16,10 @@ pub enum Status {
     },
     /// Stopped at the request of the caller (an interrupt) after `step` steps, at `t`; the
     /// trajectory ends with the state there.
-    Interrupted { step: usize, t: f64 },
+    Interrupted {
+        step: usize,
+        t: f64,
+    },
 }
 
 /// Watches a run: called after every step with the number of steps done; returning `false`
@@ -148,7 +151,13 @@ impl<'m, M: Model> Recorder<'m, M> {
     }
     /// End the run at the caller's request after `steps` steps, at `t` with the state `y` (saved
     /// if it was not).
-    pub(crate) fn interrupt(mut self, steps: usize, t: f64, y: M::State, saved: bool) -> Trajectory<M::State> {
+    pub(crate) fn interrupt(
+        mut self,
+        steps: usize,
+        t: f64,
+        y: M::State,
+        saved: bool,
+    ) -> Trajectory<M::State> {
         if !saved {
             self.save(t, y);
         }

@@ -79,7 +79,13 @@ impl Initial {
             euler: p.vec3(T, "euler", None, "rad", Range::Finite)?,
             position: p.vec3(T, "position", None, "m", Range::Finite)?,
             velocity: p.vec3(T, "velocity", Some([0.0; 3]), "m/s", Range::Finite)?,
-            angular_velocity: p.vec3(T, "angular_velocity", Some([0.0; 3]), "rad/s", Range::Finite)?,
+            angular_velocity: p.vec3(
+                T,
+                "angular_velocity",
+                Some([0.0; 3]),
+                "rad/s",
+                Range::Finite,
+            )?,
         })
     }
 }

@@ -185,14 +185,12 @@ impl Params {
     ) -> Result<&'static str> {
         let got = match self.raw(section, key)?.cloned() {
             None => allowed[0],
-            Some(Value::String(s)) => {
-                *allowed.iter().find(|a| **a == s).ok_or_else(|| {
-                    Error::InvalidInput(format!(
-                        "{section}.{key} must be one of {}, got {s:?}",
-                        quoted(allowed)
-                    ))
-                })?
-            }
+            Some(Value::String(s)) => *allowed.iter().find(|a| **a == s).ok_or_else(|| {
+                Error::InvalidInput(format!(
+                    "{section}.{key} must be one of {}, got {s:?}",
+                    quoted(allowed)
+                ))
+            })?,
             Some(other) => {
                 return Err(Error::Parse(format!(
                     "{section}.{key} must be one of {}, got {} {other}",
@@ -320,7 +318,10 @@ mod tests {
         );
         p.declare("b");
         let e = p.clone().finish().unwrap_err().to_string();
-        assert!(e.contains("unknown field `vv` in [a]; did you mean 'v'?"), "{e}");
+        assert!(
+            e.contains("unknown field `vv` in [a]; did you mean 'v'?"),
+            "{e}"
+        );
         assert!(matches!(
             p.f64("a", "missing", "kg", Range::Finite),
             Err(Error::Parse(m)) if m.contains("missing field `missing`")
@@ -334,7 +335,10 @@ mod tests {
         assert_eq!(e.to_string(), "a.x must be > 0 (kg), got -1");
         let e = p.f64("a", "y", "kg", Range::NonNegative).unwrap_err();
         assert!(e.to_string().contains("a.y must be finite"));
-        assert!(matches!(p.f64("a", "s", "kg", Range::Finite), Err(Error::Parse(_))));
+        assert!(matches!(
+            p.f64("a", "s", "kg", Range::Finite),
+            Err(Error::Parse(_))
+        ));
         let e = p.vec3("a", "v", None, "m", Range::Finite).unwrap_err();
         assert!(e.to_string().contains("3 numbers"));
         let e = Params::parse("[a\n").unwrap_err().to_string();
@@ -347,6 +351,9 @@ mod tests {
         p.declare("vessel");
         p.declare("control");
         let e = p.finish().unwrap_err().to_string();
-        assert!(e.contains("unknown table `vesel`") && e.contains("did you mean 'vessel'"), "{e}");
+        assert!(
+            e.contains("unknown table `vesel`") && e.contains("did you mean 'vessel'"),
+            "{e}"
+        );
     }
 }

@@ -99,7 +99,9 @@ impl VesselState {
                 y[i]
             )));
         }
-        Ok(Self::from_vector(&SVector::<f64, STATE_DIM>::from_column_slice(y)))
+        Ok(Self::from_vector(
+            &SVector::<f64, STATE_DIM>::from_column_slice(y),
+        ))
     }
 
     pub fn from_slice_checked(y: &[f64], orthonormalize: bool) -> Result<Self> {
@@ -112,7 +114,10 @@ impl VesselState {
         if let Some(i) = y.iter().position(|v| !v.is_finite()) {
             return Err(Error::InvalidInput(format!(
                 "the initial state must be finite; entry {i} ({}) is {}",
-                LAYOUT.iter().find(|(_, o, l)| i >= *o && i < o + l).map_or("?", |p| p.0),
+                LAYOUT
+                    .iter()
+                    .find(|(_, o, l)| i >= *o && i < o + l)
+                    .map_or("?", |p| p.0),
                 y[i]
             )));
         }

@@ -15,8 +15,8 @@ use crate::flows::affine;
 use crate::flows::collocation::{self as gauss, Blocks, Z3};
 use crate::flows::rigid_body::MagnusOrder;
 use crate::lie::so3;
-use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
 use crate::methods::Flow;
+use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// How flow S2 (linear) is integrated.
@@ -182,7 +182,10 @@ impl<'a> VesselSystem<'a> {
             a.fixed_view_mut::<3, 3>(6, 3).copy_from(&blk.awv);
             // Balance by the momentum scale (u = M v): the raw entries span many decades.
             let scale = a.abs().max().max(f64::MIN_POSITIVE);
-            let Some(ev) = (a / scale).try_schur(1e-15, 10_000).map(|s| s.complex_eigenvalues()) else {
+            let Some(ev) = (a / scale)
+                .try_schur(1e-15, 10_000)
+                .map(|s| s.complex_eigenvalues())
+            else {
                 continue;
             };
             for l in ev.iter() {
@@ -231,7 +234,9 @@ impl<'a> VesselSystem<'a> {
         for k in 0..self.accounts.len() {
             let mut p = 0.0;
             for sys in 0..2 {
-                p += z[sys][0].component_mul(&minv[sys]).dot(&booked[k][sys].at(&z[sys]));
+                p += z[sys][0]
+                    .component_mul(&minv[sys])
+                    .dot(&booked[k][sys].at(&z[sys]));
             }
             w.0[k] = self.sign(k) * p;
         }
@@ -284,7 +289,10 @@ impl<'a> VesselSystem<'a> {
     /// The power per account at `s` (W).
     pub fn power(&self, s: &VesselState, on: bool) -> Work {
         let b = self.s2_at(&s.q, on, true);
-        self.power_at(b.booked.as_ref().expect("built with the ledger"), &self.blocks_of(s))
+        self.power_at(
+            b.booked.as_ref().expect("built with the ledger"),
+            &self.blocks_of(s),
+        )
     }
 
     /// The force (N) and moment (N m) on the body, body frame, of each account at `s`.
@@ -310,7 +318,14 @@ impl<'a> VesselSystem<'a> {
     /// matrix exponential or by Gauss collocation with `stages` stages ([`LinearFlow`]). With
     /// `ledger`, also the energy booked per account over the sub-step, exactly (Van Loan
     /// Gramian, or Gauss quadrature of the quadratic power).
-    pub fn flow_s2(&self, s: &mut VesselState, h: f64, on: bool, ledger: bool, stages: usize) -> Work {
+    pub fn flow_s2(
+        &self,
+        s: &mut VesselState,
+        h: f64,
+        on: bool,
+        ledger: bool,
+        stages: usize,
+    ) -> Work {
         let b = self.s2_at(&s.q, on, ledger);
         let z0 = self.blocks_of(s);
         let (z1, work) = match self.linear {
@@ -367,7 +382,8 @@ impl<'a> VesselSystem<'a> {
                     let (f, gram) = affine::flow_and_gramian(&a, &zb, h);
                     for acc in 0..self.accounts.len() {
                         let m = power_form(&booked[acc][k], &minv[k]);
-                        let mb = SMatrix::<f64, 10, 10>::from_fn(|i, j| m[(i, j)] * scale[i] * scale[j]);
+                        let mb =
+                            SMatrix::<f64, 10, 10>::from_fn(|i, j| m[(i, j)] * scale[i] * scale[j]);
                         work.0[acc] += self.sign(acc) * affine::trace_product(&mb, &gram);
                     }
                     f * zb
@@ -515,7 +531,11 @@ impl FieldModel<{ super::STATE_DIM }> for VesselSystem<'_> {
     fn from_vector(&self, y: &SVector<f64, { super::STATE_DIM }>) -> VesselState {
         VesselState::from_vector(y)
     }
-    fn rhs(&self, t_step: f64, y: &SVector<f64, { super::STATE_DIM }>) -> SVector<f64, { super::STATE_DIM }> {
+    fn rhs(
+        &self,
+        t_step: f64,
+        y: &SVector<f64, { super::STATE_DIM }>,
+    ) -> SVector<f64, { super::STATE_DIM }> {
         self.vector_field(&VesselState::from_vector(y), self.control_on(t_step))
             .to_vector()
     }
@@ -523,7 +543,6 @@ impl FieldModel<{ super::STATE_DIM }> for VesselSystem<'_> {
         VesselSystem::power(self, &VesselState::from_vector(y), self.control_on(t_step))
     }
 }
-
 
 #[cfg(test)]
 mod tests {
@@ -550,7 +569,8 @@ mod tests {
         let (m, g) = (scalar(&v, "mass"), scalar(&v, "gravity"));
         let t = param(&v, "vessel", "inertia");
         let tau = 2.0 * std::f64::consts::PI;
-        let heave = tau * (m / (g * scalar(&v, "water_density") * scalar(&v, "waterplane_area"))).sqrt();
+        let heave =
+            tau * (m / (g * scalar(&v, "water_density") * scalar(&v, "waterplane_area"))).sqrt();
         let roll = tau * (t.x / (m * g * scalar(&v, "gm_transverse"))).sqrt();
         let pitch = tau * (t.y / (m * g * scalar(&v, "gm_longitudinal"))).sqrt();
         let mut want = vec![heave, roll, pitch];
@@ -560,10 +580,17 @@ mod tests {
         for (a, b) in got.iter().zip(&want) {
             assert!((a - b).abs() <= 1e-9 * b, "{got:?} vs {want:?}");
         }
-        assert!((pitch - 4.079).abs() < 1e-3 && (heave - 4.249).abs() < 1e-3 && (roll - 9.21).abs() < 1e-2);
+        assert!(
+            (pitch - 4.079).abs() < 1e-3
+                && (heave - 4.249).abs() < 1e-3
+                && (roll - 9.21).abs() < 1e-2
+        );
         // The controller adds the surge, sway and yaw loops (strongly damped: no faster mode).
         let on = sys.natural_periods(&Matrix3::identity(), true);
-        assert!(on.len() >= 3 && (on[0] - pitch).abs() <= 1e-9 * pitch, "{on:?}");
+        assert!(
+            on.len() >= 3 && (on[0] - pitch).abs() <= 1e-9 * pitch,
+            "{on:?}"
+        );
     }
 
     fn random_state(v: &Vessel, seed: [f64; 8]) -> VesselState {
@@ -592,7 +619,10 @@ mod tests {
     fn paper_vessel_loads_with_its_components() {
         let v = Vessel::paper();
         assert_eq!(v.body.mass, 6.3622085e6);
-        assert_eq!(param(&v, "control", "position_reference"), Vector3::new(780.0, 20.0, 0.0));
+        assert_eq!(
+            param(&v, "control", "position_reference"),
+            Vector3::new(780.0, 20.0, 0.0)
+        );
         let s = v.initial_state();
         assert!((s.euler() - Vector3::new(0.05, -0.02, 0.10)).norm() < 1e-15);
         assert!(v.energy(&s) > 0.0);
@@ -713,22 +743,38 @@ mod tests {
             let sys = VesselSystem::new(&v, None);
             let s = random_state(&v, [0.2, -0.4, 0.6, 0.3, -0.5, 0.1, 0.7, -0.3]);
             let base = Vessel::paper();
-            let d = sys.vector_field(&s, false).to_vector() - VesselSystem::new(&base, None).vector_field(&s, false).to_vector();
+            let d = sys.vector_field(&s, false).to_vector()
+                - VesselSystem::new(&base, None)
+                    .vector_field(&s, false)
+                    .to_vector();
             let (f, m) = (Vector3::new(2e5, -1e5, 3e4), Vector3::new(1e6, 0.0, -2e6));
             let r = Vector3::new(-40.0, 5.0, 3.0);
-            let (fb, mb) = if frame == "body" { (f, m) } else { (s.q.transpose() * f, s.q.transpose() * m) };
+            let (fb, mb) = if frame == "body" {
+                (f, m)
+            } else {
+                (s.q.transpose() * f, s.q.transpose() * m)
+            };
             // The load changes only the momentum rates, by the body force and its moment.
             assert!((d.fixed_rows::<3>(0) - fb).norm() < 1e-9 * fb.norm());
             assert!((d.fixed_rows::<3>(3) - (mb + r.cross(&fb))).norm() < 1e-9 * mb.norm());
             assert!(d.rows(6, 21).norm() < 1e-9);
-            let k = sys.accounts().iter().position(|a| a.name == "external").unwrap();
+            let k = sys
+                .accounts()
+                .iter()
+                .position(|a| a.name == "external")
+                .unwrap();
             let vel = s.p / v.body.mass;
             let w = s.m.component_mul(&v.body.inertia_inv);
             let expect = vel.dot(&fb) + w.dot(&(mb + r.cross(&fb)));
             assert!((sys.power(&s, false).0[k] - expect).abs() < 1e-12 * expect.abs());
             let ext = v.force("external").unwrap();
             assert!(format!("{ext:?}").contains("External"));
-            let _ = External { force: f, moment: m, point: r, frame: Frame::Body };
+            let _ = External {
+                force: f,
+                moment: m,
+                point: r,
+                frame: Frame::Body,
+            };
         }
     }
 
@@ -736,14 +782,28 @@ mod tests {
     fn external_table_is_validated() {
         let base = super::super::PAPER_VESSEL_TOML;
         for (extra, needle) in [
-            ("[external]\nforce = [1, 2]\n", "external.force must be 3 numbers"),
-            ("[external]\nforce = [1, nan, 0]\n", "external.force[1] must be finite"),
-            ("[external]\nframe = \"ned\"\n", "external.frame must be one of 'body', 'spatial'"),
-            ("[external]\npoint = [0, 0, 5000]\n", "external.point[2] must lie within"),
+            (
+                "[external]\nforce = [1, 2]\n",
+                "external.force must be 3 numbers",
+            ),
+            (
+                "[external]\nforce = [1, nan, 0]\n",
+                "external.force[1] must be finite",
+            ),
+            (
+                "[external]\nframe = \"ned\"\n",
+                "external.frame must be one of 'body', 'spatial'",
+            ),
+            (
+                "[external]\npoint = [0, 0, 5000]\n",
+                "external.point[2] must lie within",
+            ),
             ("[external]\nforse = [0, 0, 1]\n", "did you mean 'force'"),
             ("[externl]\nforce = [0, 0, 1]\n", "did you mean 'external'"),
         ] {
-            let e = Vessel::from_toml_str(&format!("{base}\n{extra}")).unwrap_err().to_string();
+            let e = Vessel::from_toml_str(&format!("{base}\n{extra}"))
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(needle), "{extra}: {e}");
         }
     }

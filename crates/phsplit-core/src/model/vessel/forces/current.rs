@@ -38,7 +38,13 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     if !p.has(T) {
         return Ok(None);
     }
-    let velocity = p.vec3(T, "velocity", Some([0.0; 3]), "m/s, spatial frame", Range::Finite)?;
+    let velocity = p.vec3(
+        T,
+        "velocity",
+        Some([0.0; 3]),
+        "m/s, spatial frame",
+        Range::Finite,
+    )?;
     for (i, v) in velocity.iter().enumerate() {
         if v.abs() > MAX_SPEED {
             return Err(Error::InvalidInput(format!(
@@ -46,7 +52,13 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
             )));
         }
     }
-    let damping = p.vec3("vessel", "damping_translational", None, "kg/s", Range::NonNegative)?;
+    let damping = p.vec3(
+        "vessel",
+        "damping_translational",
+        None,
+        "kg/s",
+        Range::NonNegative,
+    )?;
     Ok(Some(Arc::new(Current {
         velocity: velocity.into(),
         damping: damping.into(),
@@ -73,6 +85,10 @@ impl Force for Current {
         &ACCOUNTS
     }
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
-        b.force(Sys::Trans, Some(0), &Rows::constant(self.body_force(&fr.qt)));
+        b.force(
+            Sys::Trans,
+            Some(0),
+            &Rows::constant(self.body_force(&fr.qt)),
+        );
     }
 }

@@ -18,11 +18,22 @@ pub struct Damping {
     pub rotational: Vector3<f64>,
 }
 
-
 /// Keys `vessel.damping_translational`, `vessel.damping_rotational` (both required, ≥ 0).
 pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
-    let t = p.vec3("vessel", "damping_translational", None, "kg/s", Range::NonNegative)?;
-    let r = p.vec3("vessel", "damping_rotational", None, "kg m^2/s", Range::NonNegative)?;
+    let t = p.vec3(
+        "vessel",
+        "damping_translational",
+        None,
+        "kg/s",
+        Range::NonNegative,
+    )?;
+    let r = p.vec3(
+        "vessel",
+        "damping_rotational",
+        None,
+        "kg m^2/s",
+        Range::NonNegative,
+    )?;
     Ok(Some(Arc::new(Damping {
         translational: t.into(),
         rotational: r.into(),
@@ -45,7 +56,21 @@ impl Force for Damping {
         // −D ν with ν = M⁻¹ u: −Dt/mv on p, −Dr T⁻¹ on m.
         let fu_t = Matrix3::from_diagonal(&(self.translational * (-1.0 / fr.body.mass)));
         let fu_r = Matrix3::from_diagonal(&(-self.rotational.component_mul(&fr.body.inertia_inv)));
-        b.force(Sys::Trans, Some(0), &Rows { fu: fu_t, ..Rows::ZERO });
-        b.force(Sys::Rot, Some(0), &Rows { fu: fu_r, ..Rows::ZERO });
+        b.force(
+            Sys::Trans,
+            Some(0),
+            &Rows {
+                fu: fu_t,
+                ..Rows::ZERO
+            },
+        );
+        b.force(
+            Sys::Rot,
+            Some(0),
+            &Rows {
+                fu: fu_r,
+                ..Rows::ZERO
+            },
+        );
     }
 }

@@ -100,7 +100,14 @@ impl Force for Pid {
         };
         b.force(Sys::Trans, port, &pi);
         let d_t = times_diag(&fr.qt, &self.kd_translational) * fr.q;
-        b.force(Sys::Trans, damp, &Rows { fu: d_t * (-1.0 / fr.body.mass), ..Rows::ZERO });
+        b.force(
+            Sys::Trans,
+            damp,
+            &Rows {
+                fu: d_t * (-1.0 / fr.body.mass),
+                ..Rows::ZERO
+            },
+        );
         let t = b.rows(Sys::Trans);
         t.awv += Matrix3::identity();
         t.cw += offset;
@@ -115,7 +122,14 @@ impl Force for Pid {
         };
         b.force(Sys::Rot, port, &pi);
         let d_r = times_diag(&wt, &self.kd_rotational) * wm;
-        b.force(Sys::Rot, damp, &Rows { fu: -times_diag(&d_r, &fr.body.inertia_inv), ..Rows::ZERO });
+        b.force(
+            Sys::Rot,
+            damp,
+            &Rows {
+                fu: -times_diag(&d_r, &fr.body.inertia_inv),
+                ..Rows::ZERO
+            },
+        );
         b.rows(Sys::Rot).cw += theta_err;
     }
 }

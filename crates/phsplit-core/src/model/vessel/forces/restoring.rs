@@ -51,10 +51,25 @@ impl Force for Restoring {
         let mut fv = Matrix3::zeros();
         fv.set_column(2, &(col * -self.heave));
         let c = col * (-self.heave * fr.origin.z);
-        b.force(Sys::Trans, None, &Rows { fv, c, ..Rows::ZERO });
+        b.force(
+            Sys::Trans,
+            None,
+            &Rows {
+                fv,
+                c,
+                ..Rows::ZERO
+            },
+        );
         // Roll and pitch: −mu × q3 = hat(q3) mu; mu' = G hat(q3) T⁻¹ m.
         let hq3 = so3::hat(&fr.q3);
-        b.force(Sys::Rot, None, &Rows { fv: hq3, ..Rows::ZERO });
+        b.force(
+            Sys::Rot,
+            None,
+            &Rows {
+                fv: hq3,
+                ..Rows::ZERO
+            },
+        );
         let tinv = fr.body.inertia_inv;
         let mut avu = hq3;
         for i in 0..3 {
