@@ -5,23 +5,27 @@
 //! and parameter is parsed and validated by the core. Nothing here panics across the
 //! boundary: every fallible call returns `PyResult`, and a panic in the core is caught.
 
+mod convert;
 mod numerics;
+mod run;
+
+use convert::{entries, from_toml, to_table};
 
 use nalgebra::Vector3;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyReadonlyArray1};
 use phsplit_core::lie::so3;
 use phsplit_core::methods::{self, Method};
 use phsplit_core::model::vessel::{
     LinearFlow, Vessel, VesselState, VesselSystem, PAPER_VESSEL_TOML, STATE_DIM,
 };
 use phsplit_core::settings::{Settings, KEYS};
-use phsplit_core::solve::{run_watched, AccountKind, Monitor, Status};
+use phsplit_core::solve::AccountKind;
 use phsplit_core::Error;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use toml::{Table, Value};
+use pyo3::types::PyDict;
+use toml::Value;
 
 create_exception!(
     _core,
@@ -48,7 +52,7 @@ create_exception!(
     "A flow that cannot be evaluated."
 );
 
-fn to_py(e: Error) -> PyErr {
+pub(crate) fn to_py(e: Error) -> PyErr {
     match e {
         Error::InvalidInput(m) => InvalidInputError::new_err(m),
         Error::Parse(m) => ScenarioParseError::new_err(m),
@@ -56,98 +60,11 @@ fn to_py(e: Error) -> PyErr {
     }
 }
 
-/// A Python value as TOML (mappings, sequences, bool, int, float, str); `path` names it in
-/// the error.
-fn to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
-    if obj.is_instance_of::<PyBool>() {
-        return Ok(Value::Boolean(obj.extract()?));
-    }
-    if obj.is_instance_of::<PyInt>() {
-        return match obj.extract::<i64>() {
-            Ok(i) => Ok(Value::Integer(i)),
-            Err(_) => Ok(Value::Float(obj.extract()?)),
-        };
-    }
-    if obj.is_instance_of::<PyFloat>() {
-        return Ok(Value::Float(obj.extract()?));
-    }
-    if obj.is_instance_of::<PyString>() {
-        return Ok(Value::String(obj.extract()?));
-    }
-    if let Ok(d) = obj.cast::<PyDict>() {
-        return Ok(Value::Table(to_table(d, path)?));
-    }
-    if obj.is_instance_of::<PyList>()
-        || obj.is_instance_of::<PyTuple>()
-        || obj.hasattr("__array__")?
-    {
-        // numpy scalars have __array__ too: a 0-d array is a number.
-        if let Ok(x) = obj.extract::<f64>() {
-            if !obj.is_instance_of::<PyList>() && !obj.is_instance_of::<PyTuple>() {
-                return Ok(Value::Float(x));
-            }
-        }
-        let items: Vec<Bound<'_, PyAny>> = obj.try_iter()?.collect::<PyResult<_>>()?;
-        return Ok(Value::Array(
-            items
-                .iter()
-                .enumerate()
-                .map(|(i, v)| to_toml(v, &format!("{path}[{i}]")))
-                .collect::<PyResult<_>>()?,
-        ));
-    }
-    Err(InvalidInputError::new_err(format!(
-        "{path} must be a number, a string, a boolean, a sequence or a mapping, got {}",
-        obj.get_type().name()?
-    )))
-}
-
-fn to_table(d: &Bound<'_, PyDict>, path: &str) -> PyResult<Table> {
-    let mut t = Table::new();
-    for (k, v) in d.iter() {
-        let key: String = k.extract().map_err(|_| {
-            InvalidInputError::new_err(format!("the keys of {path} must be strings"))
-        })?;
-        let sub = if path.is_empty() {
-            key.clone()
-        } else {
-            format!("{path}.{key}")
-        };
-        t.insert(key, to_toml(&v, &sub)?);
-    }
-    Ok(t)
-}
-
-/// A TOML value as Python (tables → dict, arrays → list).
-fn from_toml<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
-    Ok(match v {
-        Value::String(s) => s.into_pyobject(py)?.into_any(),
-        Value::Integer(i) => i.into_pyobject(py)?.into_any(),
-        Value::Float(f) => f.into_pyobject(py)?.into_any(),
-        Value::Boolean(b) => PyBool::new(py, *b).to_owned().into_any(),
-        Value::Array(a) => {
-            let l = PyList::empty(py);
-            for x in a {
-                l.append(from_toml(py, x)?)?;
-            }
-            l.into_any()
-        }
-        Value::Table(t) => {
-            let d = PyDict::new(py);
-            for (k, x) in t {
-                d.set_item(k, from_toml(py, x)?)?;
-            }
-            d.into_any()
-        }
-        Value::Datetime(d) => d.to_string().into_pyobject(py)?.into_any(),
-    })
-}
-
 /// A vessel: rigid body, forces and ports, and default initial state (SI units).
 #[pyclass(name = "Vessel", module = "phsplit._core", frozen)]
 #[derive(Clone)]
-struct PyVessel {
-    inner: Vessel,
+pub(crate) struct PyVessel {
+    pub(crate) inner: Vessel,
 }
 
 #[pymethods]
@@ -265,22 +182,20 @@ impl PyVessel {
     }
 }
 
-fn kind_name(k: AccountKind) -> &'static str {
+pub(crate) fn kind_name(k: AccountKind) -> &'static str {
     match k {
         AccountKind::Supplied => "supplied",
         AccountKind::Dissipated => "dissipated",
     }
 }
 
-/// The entries of a 1-D array, contiguous or strided.
-fn entries(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
-    a.as_array().iter().copied().collect()
-}
-
 /// Settings from a mapping over the defaults. With `api`, a value of the wrong type is an
 /// InvalidInputError (a function argument) and names the argument; otherwise a
 /// ScenarioParseError naming `simulation.<key>` (a file).
-fn settings_of(d: &Bound<'_, PyDict>, api: bool) -> PyResult<(Settings, Option<String>)> {
+pub(crate) fn settings_of(
+    d: &Bound<'_, PyDict>,
+    api: bool,
+) -> PyResult<(Settings, Option<String>)> {
     let t = to_table(d, if api { "" } else { "simulation" })?;
     Settings::from_table(&t).map_err(|e| match (api, e) {
         (true, Error::Parse(m)) | (true, Error::InvalidInput(m)) => {
@@ -290,7 +205,7 @@ fn settings_of(d: &Bound<'_, PyDict>, api: bool) -> PyResult<(Settings, Option<S
     })
 }
 
-fn settings_dict<'py>(
+pub(crate) fn settings_dict<'py>(
     py: Python<'py>,
     s: &Settings,
     name: Option<String>,
@@ -385,270 +300,6 @@ fn method_info<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyDict>>
     Ok(d)
 }
 
-/// Watches a run from Python: about every 0.1 s it takes the GIL, runs Python's signal
-/// handlers (Ctrl-C, or SIGTERM where the program turned it into KeyboardInterrupt) and calls
-/// the progress callback `f(steps_done, n_steps)`. An exception stops the run; it is kept to be
-/// raised (or, for KeyboardInterrupt, reported as an interrupted run) once the GIL is back.
-struct PyMonitor {
-    progress: Option<Py<PyAny>>,
-    n_steps: usize,
-    last: std::time::Instant,
-    error: Option<PyErr>,
-}
-
-impl Monitor for PyMonitor {
-    fn keep_going(&mut self, done: usize) -> bool {
-        if done % 256 != 0 || self.last.elapsed().as_secs_f64() < 0.1 {
-            return true;
-        }
-        self.last = std::time::Instant::now();
-        let r = Python::attach(|py| -> PyResult<()> {
-            py.check_signals()?;
-            if let Some(cb) = &self.progress {
-                cb.call1(py, (done, self.n_steps))?;
-            }
-            Ok(())
-        });
-        match r {
-            Ok(()) => true,
-            Err(e) => {
-                self.error = Some(e);
-                false
-            }
-        }
-    }
-}
-
-/// Integrate with the given settings (a mapping over the defaults) from `state0` (a flat
-/// 27-vector; None: the vessel's initial state); returns a dict of numpy arrays. The GIL is
-/// released while integrating; signals are checked about every 0.1 s, and Ctrl-C returns what
-/// was computed with status "interrupted". `progress(steps_done, n_steps)` is called as often.
-#[pyfunction]
-#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None, extrema=false, continuing=false))]
-fn integrate<'py>(
-    py: Python<'py>,
-    vessel: &PyVessel,
-    settings: &Bound<'py, PyDict>,
-    state0: Option<PyReadonlyArray1<'_, f64>>,
-    orthonormalize: bool,
-    progress: Option<Py<PyAny>>,
-    extrema: bool,
-    continuing: bool,
-) -> PyResult<Bound<'py, PyDict>> {
-    let (settings, _) = settings_of(settings, true)?;
-    let opts = settings.options().map_err(to_py)?;
-    let y0 = match &state0 {
-        None => vessel.inner.initial_state(),
-        Some(a) if continuing => VesselState::from_slice_continuing(&entries(a)).map_err(to_py)?,
-        Some(a) => VesselState::from_slice_checked(&entries(a), orthonormalize).map_err(to_py)?,
-    };
-    let v = vessel.inner.clone();
-    let s2 = settings.clone();
-    let mut monitor = PyMonitor {
-        progress,
-        n_steps: opts.n_steps,
-        last: std::time::Instant::now(),
-        error: None,
-    };
-    let mon = &mut monitor;
-    // A panic in the core (a bug) reaches Python as a PhsplitError, never an abort.
-    let out = py
-        .detach(move || {
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                let sys = VesselSystem::new(&v, s2.control_start)
-                    .with_linear_flow(s2.linear_flow)
-                    .with_projection(s2.project_invariants)
-                    .with_extrema(extrema);
-                let traj = run_watched(&sys, &s2.method, y0, &opts, mon)?;
-                // The force and moment of each account at the saved states.
-                let wrenches: Vec<_> = traj
-                    .t
-                    .iter()
-                    .zip(&traj.states)
-                    .map(|(t, s)| sys.account_wrenches(s, sys.control_on(*t)))
-                    .collect();
-                Ok::<_, Error>((traj, wrenches))
-            }))
-        })
-        .map_err(|p| {
-            let msg = p
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_else(|| "unknown panic".into());
-            PhsplitError::new_err(format!("internal error in the phsplit core: {msg}"))
-        })?
-        .map_err(to_py)?;
-    let (traj, wrenches) = out;
-    if let Some(e) = monitor.error.take() {
-        if !e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-            return Err(e); // an exception of the progress callback, or of a signal handler
-        }
-    }
-    let n = traj.t.len();
-    let k = traj.accounts.len();
-    let mut cols: [Vec<f64>; 8] = Default::default();
-    let mut qmat = Vec::with_capacity(9 * n);
-    let mut quat = Vec::with_capacity(4 * n);
-    for s in &traj.states {
-        for (c, v) in cols
-            .iter_mut()
-            .zip([s.p, s.m, s.mu, s.x, s.phi_th, s.phi_x, s.euler()])
-        {
-            c.extend_from_slice(v.as_slice());
-        }
-        // Q row-major, as numpy expects for a (3, 3) block.
-        for i in 0..3 {
-            for j in 0..3 {
-                qmat.push(s.q[(i, j)]);
-            }
-        }
-        quat.extend_from_slice(so3::quaternion(&s.q).as_slice());
-        cols[7].push(so3::orthogonality_defect(&s.q));
-    }
-    let d = PyDict::new(py);
-    let arr3 = |v: &Vec<f64>| PyArray1::from_slice(py, v).reshape([n, 3]);
-    d.set_item("t", PyArray1::from_vec(py, traj.t.clone()))?;
-    for (i, name) in ["p", "m", "mu", "x", "phi_th", "phi_x", "euler"]
-        .iter()
-        .enumerate()
-    {
-        d.set_item(*name, arr3(&cols[i])?)?;
-    }
-    d.set_item(
-        "orthogonality_defect",
-        PyArray1::from_vec(py, cols[7].clone()),
-    )?;
-    d.set_item("Q", PyArray1::from_vec(py, qmat).reshape([n, 3, 3])?)?;
-    d.set_item("quaternion", PyArray1::from_vec(py, quat).reshape([n, 4])?)?;
-    d.set_item("energy", PyArray1::from_vec(py, traj.energy.clone()))?;
-    d.set_item("supplied", PyArray1::from_vec(py, traj.supplied.clone()))?;
-    d.set_item(
-        "dissipated",
-        PyArray1::from_vec(py, traj.dissipated.clone()),
-    )?;
-    let names: Vec<&str> = traj.accounts.iter().map(|a| a.name).collect();
-    let kinds: Vec<&str> = traj.accounts.iter().map(|a| kind_name(a.kind)).collect();
-    d.set_item("accounts", names)?;
-    d.set_item("account_kinds", kinds)?;
-    let booked: Vec<f64> = traj.booked.iter().flat_map(|w| w.0[..k].to_vec()).collect();
-    d.set_item("booked", PyArray1::from_vec(py, booked).reshape([n, k])?)?;
-    let mut force = Vec::with_capacity(n * k * 3);
-    let mut moment = Vec::with_capacity(n * k * 3);
-    for w in &wrenches {
-        for (f, m) in w {
-            force.extend_from_slice(f.as_slice());
-            moment.extend_from_slice(m.as_slice());
-        }
-    }
-    d.set_item(
-        "account_force",
-        PyArray1::from_vec(py, force).reshape([n, k, 3])?,
-    )?;
-    d.set_item(
-        "account_moment",
-        PyArray1::from_vec(py, moment).reshape([n, k, 3])?,
-    )?;
-    d.set_item("steps", traj.steps)?;
-    d.set_item(
-        "last_good",
-        PyArray1::from_slice(py, traj.last_good.to_vector().as_slice()),
-    )?;
-    d.set_item("t_last_good", traj.t_last_good)?;
-    let ext = PyDict::new(py);
-    for (k, name) in traj.probe_names.iter().enumerate() {
-        ext.set_item(*name, (traj.probe_max[k], traj.probe_max_t[k]))?;
-    }
-    d.set_item("running_max", ext)?;
-    d.set_item("settings", settings_dict(py, &settings, None)?)?;
-    match traj.status {
-        Status::Completed => d.set_item("status", "completed")?,
-        Status::Failed { step, t, reason } => {
-            d.set_item("status", "failed")?;
-            d.set_item("failure", format!("step {step} (t = {t}): {reason}"))?;
-        }
-        Status::Interrupted { step, t } => {
-            d.set_item("status", "interrupted")?;
-            d.set_item(
-                "failure",
-                format!("interrupted after step {step} (t = {t})"),
-            )?;
-        }
-    }
-    Ok(d)
-}
-
-/// A compiled right-hand side `f(t, y)` of eq. (39) for external solvers (scipy, CVODE):
-/// `y` a flat 27-vector; the controller acts from `control_start` (None: never).
-#[pyclass(name = "VectorField", module = "phsplit._core", frozen)]
-struct PyVectorField {
-    vessel: Vessel,
-    control_start: Option<f64>,
-}
-
-#[pymethods]
-impl PyVectorField {
-    #[new]
-    #[pyo3(signature = (vessel, control_start=None))]
-    fn new(vessel: &PyVessel, control_start: Option<f64>) -> Self {
-        Self {
-            vessel: vessel.inner.clone(),
-            control_start,
-        }
-    }
-    /// `y' = f(t, y)` as a new array.
-    fn __call__<'py>(
-        &self,
-        py: Python<'py>,
-        t: f64,
-        y: PyReadonlyArray1<'_, f64>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let d = self.field(t, &y)?;
-        Ok(PyArray1::from_slice(py, d.as_slice()))
-    }
-    /// `f(t, y)` written into `out` (the CVODE calling convention `f(t, y, yp)`).
-    fn into(
-        &self,
-        t: f64,
-        y: PyReadonlyArray1<'_, f64>,
-        mut out: numpy::PyReadwriteArray1<'_, f64>,
-    ) -> PyResult<()> {
-        let d = self.field(t, &y)?;
-        let o = out
-            .as_slice_mut()
-            .map_err(|e| InvalidInputError::new_err(e.to_string()))?;
-        if o.len() != STATE_DIM {
-            return Err(InvalidInputError::new_err(format!(
-                "out must have {STATE_DIM} entries, got {}",
-                o.len()
-            )));
-        }
-        o.copy_from_slice(d.as_slice());
-        Ok(())
-    }
-}
-
-impl PyVectorField {
-    /// The field at a 27-vector, without the finiteness check (solvers probe freely).
-    fn field(
-        &self,
-        t: f64,
-        y: &PyReadonlyArray1<'_, f64>,
-    ) -> PyResult<nalgebra::SVector<f64, STATE_DIM>> {
-        let s = entries(y);
-        if s.len() != STATE_DIM {
-            return Err(InvalidInputError::new_err(format!(
-                "a state is a flat vector of {STATE_DIM} numbers, got {}",
-                s.len()
-            )));
-        }
-        let s =
-            VesselState::from_vector(&nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(&s));
-        let sys = VesselSystem::new(&self.vessel, self.control_start);
-        Ok(sys.vector_field(&s, sys.control_on(t)).to_vector())
-    }
-}
-
 /// Euler angles (ZYX: roll, pitch, yaw) of a 3×3 attitude matrix, eq. (21).
 #[pyfunction]
 fn euler_zyx(q: [[f64; 3]; 3]) -> [f64; 3] {
@@ -667,8 +318,7 @@ fn vessel_tables() -> Vec<&'static str> {
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     numerics::register(m)?;
     m.add_class::<PyVessel>()?;
-    m.add_class::<PyVectorField>()?;
-    m.add_function(wrap_pyfunction!(integrate, m)?)?;
+    run::register(m)?;
     m.add_function(wrap_pyfunction!(method_info, m)?)?;
     m.add_function(wrap_pyfunction!(euler_zyx, m)?)?;
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
