@@ -90,6 +90,7 @@ def _parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     rr.add_argument("file", help="a NetCDF file written by phsplit")
+    rr.add_argument("--out", help="also write the rerun as <out>/<file name>")
     pl = sub.add_parser(
         "plot",
         help="draw the DP figure of a phsplit NetCDF file",
@@ -102,7 +103,6 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("file", help="a NetCDF file written by phsplit")
     pl.add_argument("--out", help="the image to write (default: FILE with .png; .pdf and .svg work too)")
     pl.add_argument("--watch-circle", type=float, help="radius of the watch circle about the set point, m")
-    rr.add_argument("--out", help="also write the rerun as <out>/<file name>")
     w.add_argument("sweep", help="sweep TOML file ([simulation] + [sweep])")
     w.add_argument("--out", help="result store (a folder; default: <sweep name>.store)")
     w.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://host:8786")
