@@ -158,6 +158,34 @@ CATALOGUE: list[Bad] = [
         E, ("current.velocity[0]", "10 m/s")),
     Bad("current given as a speed", vessel_with("[initial]", "[current]\nspeed = 1.0\n[initial]"), P,
         ("speed", "[current]", "velocity")),
+    Bad("pipe with a negative submerged weight",
+        vessel_with("[initial]", "[pipe]\nsubmerged_weight = -800.0\nwater_depth = 300.0\nhang_off = [-60.0, 0.0, 3.0]\n"
+                    "horizontal_tension = 5e5\nlay_direction = 0.0\n[initial]"), E,
+        ("pipe.submerged_weight", "> 0", "N/m")),
+    Bad("pipe hung off kilometres above the deck",
+        vessel_with("[initial]", "[pipe]\nsubmerged_weight = 800.0\nwater_depth = 300.0\nhang_off = [-60.0, 0.0, 3000.0]\n"
+                    "horizontal_tension = 5e5\nlay_direction = 0.0\n[initial]"), E,
+        ("pipe.hang_off[2]", "1000 m")),
+    Bad("pipe with two tensions",
+        vessel_with("[initial]", "[pipe]\nsubmerged_weight = 800.0\nwater_depth = 300.0\nhang_off = [-60.0, 0.0, 3.0]\n"
+                    "horizontal_tension = 5e5\ntop_tension = 8e5\nlay_direction = 0.0\n[initial]"), E,
+        ("exactly one of", "horizontal_tension", "top_tension")),
+    Bad("pipe top tension below the hanging weight",
+        vessel_with("[initial]", "[pipe]\nsubmerged_weight = 800.0\nwater_depth = 300.0\nhang_off = [-60.0, 0.0, 3.0]\n"
+                    "top_tension = 1e5\nlay_direction = 0.0\n[initial]"), E,
+        ("pipe.top_tension", "must exceed")),
+    Bad("pipe without a lay direction",
+        vessel_with("[initial]", "[pipe]\nsubmerged_weight = 800.0\nwater_depth = 300.0\nhang_off = [-60.0, 0.0, 3.0]\n"
+                    "departure_angle = 45.0\n[initial]"), E,
+        ("lay_direction", "[pipe]", "degrees")),
+    Bad("set-point times not increasing",
+        vessel_with("[initial]", "[setpoint]\nnatural_frequency = 0.05\ntimes = [0.0, 60.0, 30.0]\n"
+                    "positions = [[780.0, 20.0, 0.0], [800.0, 20.0, 0.0], [820.0, 20.0, 0.0]]\n[initial]"), E,
+        ("setpoint.times", "increase strictly")),
+    Bad("set point with both times and a speed",
+        vessel_with("[initial]", "[setpoint]\nnatural_frequency = 0.05\ntimes = [0.0, 60.0]\nspeed = 0.5\n"
+                    "positions = [[780.0, 20.0, 0.0], [800.0, 20.0, 0.0]]\n[initial]"), E,
+        ("[setpoint]", "times", "speed")),
     Bad("misspelt component table", vessel_with("[initial]", "[externl]\nforce = [1.0, 0.0, 0.0]\n[initial]"), P,
         ("externl", "did you mean 'external'")),
     # simulation arguments

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 
 def hat(w):
@@ -52,6 +53,12 @@ class Field:
         if ext:
             self.ext = (np.array(ext.get("force", [0.0] * 3), float), np.array(ext.get("moment", [0.0] * 3), float),
                         np.array(ext.get("point", [0.0] * 3), float), ext.get("frame", "body"))
+        pipe = params.get("pipe")
+        self.pipe = dict(pipe) if pipe else None
+        sp = params.get("setpoint")
+        # the moving set point: the third-order filter's states are integrated with the vessel
+        # (y[27:45]: x_d, x_d', x_d'' for the six channels), driven by the set point r(t)
+        self.sp = dict(sp) if sp else None
         cur = params.get("current")
         # a uniform current V_c (spatial): the translational damping acts on v - Q^T V_c
         self.vc = np.array(cur.get("velocity", [0.0] * 3), float) if cur else np.zeros(3)
@@ -65,6 +72,45 @@ class Field:
             f, m = Q.T @ f, Q.T @ m
         return f, m + np.cross(r, f)
 
+    def pipe_force(self, t, x, Q):
+        """The catenary's spatial force at the hang-off point (docs/model.md 5.6), written again:
+        the span to the touchdown point gives a = H/w by root finding on X = a acosh(1 + d/a)."""
+        pp = self.pipe
+        w, r = pp["submerged_weight"], np.array(pp["hang_off"], float)
+        top = x + Q @ r
+        d = pp["water_depth"] + top[2]
+        ang = np.radians(pp.get("lay_direction", 0.0))
+        e_lay = np.array([np.cos(ang), np.sin(ang)])
+        if "touchdown" in pp:
+            tdp = np.array(pp["touchdown"], float) + e_lay * pp.get("lay_speed", 0.0) * max(t, 0.0)
+            rh = top[:2] - tdp
+            X = np.hypot(*rh)
+            e = rh / X
+            a = np.exp(brentq(lambda la: np.exp(la) * np.arccosh(1 + d / np.exp(la)) - X, -30.0, 40.0,
+                              xtol=1e-15, rtol=1e-15))
+        else:
+            e = e_lay
+            a = pp["horizontal_tension"] / w
+        s = np.sqrt(d * d + 2 * a * d)
+        H = w * a
+        return np.array([-H * e[0], -H * e[1], -w * s])
+
+    def r_of(self, t):
+        """The set point (6 channels) and its slope at t: waypoints passed at the given speed."""
+        sp = self.sp
+        pos = np.array(sp["positions"], float)
+        t0 = sp.get("start_time", 0.0)
+        seg = np.hypot.reduce(np.diff(pos, axis=0), axis=1) if len(pos) > 1 else np.zeros(0)
+        times = t0 + np.concatenate([[0.0], np.cumsum(seg / sp["speed"])])
+        yaw = np.array(sp.get("headings", [self.thr[2]] * len(pos)), float)
+        rows = np.column_stack([pos, np.tile(self.thr[:2], (len(pos), 1)), yaw])
+        k = max(0, min(np.searchsorted(times, t, side="right") - 1, len(times) - 1))
+        if k + 1 < len(times):
+            slope = (rows[k + 1] - rows[k]) / (times[k + 1] - times[k])
+        else:
+            slope = np.zeros(6)
+        return rows[k] + slope * max(t - times[k], 0.0), slope
+
     def __call__(self, t, y):
         p, m, Q = y[0:3], y[3:6], y[6:15].reshape(3, 3, order="F")
         mu, x, phth, phx = y[15:18], y[18:21], y[21:24], y[24:27]
@@ -73,19 +119,33 @@ class Field:
         th = euler_zyx(Q)
         W = np.linalg.solve(pi_e(th), Q)
         K = self.K
-        tau_t = -Q.T @ (K["kp_translational"] @ (x - self.xr) + K["kd_translational"] @ Q @ v
+        xr, thr, vd, thd = self.xr, self.thr, np.zeros(3), np.zeros(3)
+        n = 27
+        if self.sp is not None:
+            om, ze = self.sp["natural_frequency"], self.sp.get("relative_damping", 1.0)
+            f = y[27:45].reshape(3, 6)  # rows: value, rate, acceleration
+            xr, thr, vd, thd = f[0, :3], f[0, 3:], f[1, :3], f[1, 3:]
+            r, _ = self.r_of(t)
+            jerk = om ** 3 * (r - f[0]) - (2 * ze + 1) * om ** 2 * f[1] - (2 * ze + 1) * om * f[2]
+            n = 45
+        tau_t = -Q.T @ (K["kp_translational"] @ (x - xr) + K["kd_translational"] @ (Q @ v - vd)
                         + K["ki_translational"] @ phx)
-        tau_r = -W.T @ (K["kp_rotational"] @ (th - self.thr) + K["kd_rotational"] @ W @ w
+        tau_r = -W.T @ (K["kp_rotational"] @ (th - thr) + K["kd_rotational"] @ (W @ w - thd)
                         + K["ki_rotational"] @ phth)
         fe, me = self.external(Q)
-        dy = np.empty(27)
+        if self.pipe is not None:
+            fp = Q.T @ self.pipe_force(t, x, Q)
+            fe, me = fe + fp, me + np.cross(np.array(self.pipe["hang_off"], float), fp)
+        dy = np.empty(n)
+        if n == 45:
+            dy[27:45] = np.concatenate([f[1], f[2], jerk])
         dy[0:3] = -np.cross(w, p) - (self.Dt * (v - Q.T @ self.vc) + Q.T @ (self.lam * x) - tau_t) + fe
         dy[3:6] = -np.cross(w, m) - (self.Dr * w + np.cross(mu, q3) - tau_r) + me
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)
         dy[18:21] = Q @ v
-        dy[21:24] = (th - self.thr) if self.on else 0.0
-        dy[24:27] = (x - self.xr) if self.on else 0.0
+        dy[21:24] = (th - thr) if self.on else 0.0
+        dy[24:27] = (x - xr) if self.on else 0.0
         return dy
 
     def control_torque(self, y):
@@ -116,7 +176,12 @@ def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | Non
     t_eval = np.asarray(t_eval) if t_eval is not None else np.array([t_end])
     ts, ys = [], []
     y = np.array(y0, dtype=float)
-    atol = np.maximum(np.abs(y0), 1.0) * rtol * 1e-3
+    if "setpoint" in params and len(y) == 27:
+        # the filter starts at rest on the first set point
+        f0 = Field(params, True)
+        r0, _ = f0.r_of(params["setpoint"].get("start_time", 0.0))
+        y = np.concatenate([y, r0, np.zeros(12)])
+    atol = np.maximum(np.abs(y), 1.0) * rtol * 1e-3
     for a, b, on in segments:
         f = Field(params, on)
         last = b == t_end

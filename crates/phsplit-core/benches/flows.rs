@@ -34,7 +34,7 @@ fn flows(c: &mut Criterion) {
     }
     let sys = VesselSystem::new(&vessel, Some(0.0));
     c.bench_function("vector field (eq. 39)", |b| {
-        b.iter(|| sys.vector_field(black_box(&y0), true))
+        b.iter(|| sys.vector_field(black_box(&y0), 0.0, true))
     });
     for (name, lf, order) in [
         ("exact", LinearFlow::Exact, 2usize),
@@ -49,7 +49,7 @@ fn flows(c: &mut Criterion) {
                 |b| {
                     b.iter(|| {
                         let mut s = y0;
-                        sys.flow_s2(&mut s, black_box(0.5), true, ledger, order.div_ceil(2))
+                        sys.flow_s2(&mut s, black_box(0.5), 0.0, true, ledger, order.div_ceil(2))
                     })
                 },
             );

@@ -30,7 +30,7 @@ fn running_maxima_cover_every_step_whatever_is_saved() {
         let mut fmax = 0.0f64;
         let mut mmax = 0.0f64;
         for (t, s) in all.t.iter().zip(&all.states) {
-            let w = sys.account_wrenches(s, sys.control_on(*t));
+            let w = sys.account_wrenches(s, *t, sys.control_on(*t));
             let f = w[c].0 + w[cd].0;
             let m = w[c].1 + w[cd].1;
             fmax = fmax.max(f.norm());
@@ -48,7 +48,7 @@ fn running_maxima_cover_every_step_whatever_is_saved() {
         // and the peak is larger than what the 50th-step samples show
         let mut sampled = 0.0f64;
         for (t, s) in some.t.iter().zip(&some.states) {
-            let w = sys.account_wrenches(s, sys.control_on(*t));
+            let w = sys.account_wrenches(s, *t, sys.control_on(*t));
             sampled = sampled.max((w[c].0 + w[cd].0).norm());
         }
         assert!(

@@ -93,9 +93,15 @@ fn integrate<'py>(
                     .t
                     .iter()
                     .zip(&traj.states)
-                    .map(|(t, s)| sys.account_wrenches(s, sys.control_on(*t)))
+                    .map(|(t, s)| sys.account_wrenches(s, *t, sys.control_on(*t)))
                     .collect();
-                Ok::<_, Error>((traj, wrenches))
+                let outputs: Vec<_> = traj
+                    .t
+                    .iter()
+                    .zip(&traj.states)
+                    .map(|(t, s)| sys.outputs(s, *t))
+                    .collect();
+                Ok::<_, Error>((traj, wrenches, outputs))
             }))
         })
         .map_err(|p| {
@@ -107,7 +113,7 @@ fn integrate<'py>(
             PhsplitError::new_err(format!("internal error in the phsplit core: {msg}"))
         })?
         .map_err(to_py)?;
-    let (traj, wrenches) = out;
+    let (traj, wrenches, outputs) = out;
     if let Some(e) = monitor.error.take() {
         if !e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
             return Err(e); // an exception of the progress callback, or of a signal handler
@@ -177,6 +183,15 @@ fn integrate<'py>(
         "account_moment",
         PyArray1::from_vec(py, moment).reshape([n, k, 3])?,
     )?;
+    // The components' reported quantities: name -> (unit, long name, values at the saved states).
+    let reported = PyDict::new(py);
+    if let Some(first) = outputs.first() {
+        for (k, o) in first.iter().enumerate() {
+            let vals: Vec<f64> = outputs.iter().map(|row| row[k].value).collect();
+            reported.set_item(o.name, (o.unit, o.long_name, PyArray1::from_vec(py, vals)))?;
+        }
+    }
+    d.set_item("outputs", reported)?;
     d.set_item("steps", traj.steps)?;
     d.set_item(
         "last_good",
@@ -273,7 +288,7 @@ impl PyVectorField {
         let s =
             VesselState::from_vector(&nalgebra::SVector::<f64, STATE_DIM>::from_column_slice(&s));
         let sys = VesselSystem::new(&self.vessel, self.control_start);
-        Ok(sys.vector_field(&s, sys.control_on(t)).to_vector())
+        Ok(sys.vector_field(&s, t, sys.control_on(t)).to_vector())
     }
 }
 

@@ -194,6 +194,9 @@ class Solution:
     account_force: np.ndarray | None = None
     account_moment: np.ndarray | None = None
     settings: dict[str, Any] = field(default_factory=dict)
+    #: What the components report at the saved states (the pipe's top tension, the moving set
+    #: point, ...): name -> (unit, long name, values).
+    outputs: dict[str, tuple[str, str, np.ndarray]] = field(default_factory=dict)
 
     def force(self, *accounts: str) -> np.ndarray:
         """Body-frame force (N, 3) of the named ledger accounts, summed (all when none given)."""
@@ -335,6 +338,8 @@ class Solution:
             ds[f"force_{name}"] = var(("time", "axis"), self.account_force[:, k, :], "N", f"force of {name}, body frame")
             ds[f"moment_{name}"] = var(("time", "axis"), self.account_moment[:, k, :], "N m",
                                        f"moment of {name} about the body origin, body frame")
+        for name, (unit, long_name, values) in self.outputs.items():
+            ds[name] = var(("time",), values, unit, long_name)
         prov = self.meta.get("provenance", {})
         if "initial_state" in prov:
             ds["initial_state"] = var(("state",), prov["initial_state"], "1",
@@ -622,6 +627,7 @@ def simulate(
         meta={"mass": body["mass"], "inertia": body["inertia"], "t_last_good": raw["t_last_good"],
               "components": vessel.components},
         account_force=raw["account_force"], account_moment=raw["account_moment"], settings=dict(used),
+        outputs={k: (u, ln, np.asarray(v)) for k, (u, ln, v) in raw.get("outputs", {}).items()},
     )
     # What reruns it (phsplit rerun): the vessel file, the initial state the core used, one chunk.
     sol.meta["running_max"] = dict(raw["running_max"])

@@ -1,3 +1,5 @@
 //! Models: the vessel (paper §3.4) with its forces and ports as components. Models implement
 //! the solver's traits ([`crate::solve::system`]); the solver never imports a model.
+pub mod catenary;
+pub mod reference;
 pub mod vessel;

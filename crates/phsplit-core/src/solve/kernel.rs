@@ -50,18 +50,28 @@ pub fn run_splitting_watched<M: SplitModel>(
     let mut rec = Recorder::new(model, opts.t0, y0, opts);
     let mut y = y0;
     // A last sub-step deferred into the next step: (flow, length, its step's start time).
-    let mut pending: Option<(Flow, f64, f64)> = None;
+    // A last sub-step deferred into the next step: (flow, length, its step's start time, the
+    // time it starts at).
+    let mut pending: Option<(Flow, f64, f64, f64)> = None;
     for n in 0..opts.n_steps {
         let t = opts.t0 + n as f64 * opts.h;
         let (hn, t1) = (opts.step_length(n), opts.time_after(n));
+        // Each flow's own clock: a sub-step of a flow starts at the step's start plus the
+        // lengths of the earlier sub-steps of the same flow (time is carried by each flow as
+        // an extra state with `t' = 1`, so a time-dependent flow keeps the method's order).
+        let mut clock = [t, t];
         for (i, &(flow, c)) in subs.iter().enumerate() {
             let mut len = c * hn;
+            let k = flow_index(flow);
+            let mut start = clock[k];
+            clock[k] += len;
             if i == 0 {
-                if let Some((pf, plen, pt)) = pending.take() {
+                if let Some((pf, plen, pt, pc)) = pending.take() {
                     if pf == flow && model.same_field(pt, t) {
                         len += plen;
+                        start = pc;
                     } else {
-                        rec.acc += model.flow(pf, plen, pt, method.order, opts.ledger, &mut y);
+                        rec.acc += model.flow(pf, plen, pt, pc, method.order, opts.ledger, &mut y);
                     }
                 }
             }
@@ -71,10 +81,10 @@ pub fn run_splitting_watched<M: SplitModel>(
                 && model.same_field(t, t1)
                 && !model.projects()
             {
-                pending = Some((flow, len, t));
+                pending = Some((flow, len, t, start));
                 continue;
             }
-            rec.acc += model.flow(flow, len, t, method.order, opts.ledger, &mut y);
+            rec.acc += model.flow(flow, len, t, start, method.order, opts.ledger, &mut y);
         }
         if !model.is_finite(&y) {
             return Ok(rec.fail(n, t));
@@ -95,8 +105,8 @@ pub fn run_splitting_watched<M: SplitModel>(
         }
         if n + 1 < opts.n_steps && !monitor.keep_going(n + 1) {
             // Complete the step (a deferred sub-step), then stop on its boundary.
-            if let Some((pf, plen, pt)) = pending.take() {
-                rec.acc += model.flow(pf, plen, pt, method.order, opts.ledger, &mut y);
+            if let Some((pf, plen, pt, pc)) = pending.take() {
+                rec.acc += model.flow(pf, plen, pt, pc, method.order, opts.ledger, &mut y);
                 if !model.is_finite(&y) {
                     return Ok(rec.fail(n, t));
                 }
@@ -105,6 +115,14 @@ pub fn run_splitting_watched<M: SplitModel>(
         }
     }
     Ok(rec.traj)
+}
+
+/// The index of a flow's clock.
+fn flow_index(f: Flow) -> usize {
+    match f {
+        Flow::S1 => 0,
+        Flow::S2 => 1,
+    }
 }
 
 /// Run an explicit Runge–Kutta method on the full vector field.
@@ -141,9 +159,10 @@ pub fn run_runge_kutta_watched<const N: usize, M: FieldModel<N>>(
                     yi.axpy(h * aij, &k[j], 1.0);
                 }
             }
-            k[i] = model.rhs(t, &yi);
+            let ti = t + tableau.c[i] * h;
+            k[i] = model.rhs(t, ti, &yi);
             if opts.ledger {
-                work += model.power(t, &yi).scaled(h * tableau.b[i]);
+                work += model.power(t, ti, &yi).scaled(h * tableau.b[i]);
             }
         }
         let mut y1 = y;
@@ -260,6 +279,7 @@ mod tests {
             which: Flow,
             h: f64,
             _t: f64,
+            _at: f64,
             _o: usize,
             ledger: bool,
             s: &mut [f64; 2],
@@ -300,14 +320,14 @@ mod tests {
         fn from_vector(&self, y: &SVector<f64, 2>) -> [f64; 2] {
             [y[0], y[1]]
         }
-        fn rhs(&self, _t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
+        fn rhs(&self, _t: f64, _at: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
             let g = self.growth.map_or(-D, |g| g);
             SVector::<f64, 2>::new(
                 y[1],
                 -y[0] + g * y[1] + if self.growth.is_some() { 0.0 } else { U },
             )
         }
-        fn power(&self, _t: f64, y: &SVector<f64, 2>) -> Work {
+        fn power(&self, _t: f64, _at: f64, y: &SVector<f64, 2>) -> Work {
             let mut w = Work::default();
             w.0[0] = y[1] * U;
             w.0[1] = D * y[1] * y[1];
@@ -556,11 +576,12 @@ mod tests {
             which: Flow,
             h: f64,
             t: f64,
+            at: f64,
             o: usize,
             ledger: bool,
             s: &mut [f64; 2],
         ) -> Work {
-            self.inner.flow(which, h, t, o, ledger, s)
+            self.inner.flow(which, h, t, at, o, ledger, s)
         }
     }
     impl FieldModel<2> for Projected {
@@ -570,11 +591,11 @@ mod tests {
         fn from_vector(&self, y: &SVector<f64, 2>) -> [f64; 2] {
             self.inner.from_vector(y)
         }
-        fn rhs(&self, t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
-            self.inner.rhs(t, y)
+        fn rhs(&self, t: f64, at: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
+            self.inner.rhs(t, at, y)
         }
-        fn power(&self, t: f64, y: &SVector<f64, 2>) -> Work {
-            self.inner.power(t, y)
+        fn power(&self, t: f64, at: f64, y: &SVector<f64, 2>) -> Work {
+            self.inner.power(t, at, y)
         }
     }
 

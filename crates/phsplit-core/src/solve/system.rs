@@ -102,14 +102,18 @@ pub trait SplitModel: Model {
     /// Check that the model can provide sub-flows of order `order` (paper Remark 2.3); the
     /// kernel asks this once, before the first step.
     fn supports_order(&self, order: usize) -> crate::Result<()>;
-    /// Advance `s` by flow `which` over `h` (of either sign) on a step that starts at `t_step`.
+    /// Advance `s` by flow `which` over `h` (of either sign) on a step that starts at `t_step`
+    /// (which decides switches, like the controller's start); the sub-step itself starts at
+    /// time `t` (the flow's own clock: a time-dependent flow is evaluated from `t` to `t + h`).
     /// `order` is the order of the composition, for flows that are approximated to match.
     /// Returns the energy booked per account over the sub-step when `ledger` is set.
+    #[allow(clippy::too_many_arguments)]
     fn flow(
         &self,
         which: Flow,
         h: f64,
         t_step: f64,
+        t: f64,
         order: usize,
         ledger: bool,
         s: &mut Self::State,
@@ -120,8 +124,8 @@ pub trait SplitModel: Model {
 pub trait FieldModel<const N: usize>: Model {
     fn to_vector(&self, s: &Self::State) -> SVector<f64, N>;
     fn from_vector(&self, y: &SVector<f64, N>) -> Self::State;
-    /// `y'` on a step that starts at `t_step`.
-    fn rhs(&self, t_step: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
-    /// The power per account at `y` on a step that starts at `t_step`.
-    fn power(&self, t_step: f64, y: &SVector<f64, N>) -> Work;
+    /// `y'` at time `t` on a step that starts at `t_step` (which decides switches).
+    fn rhs(&self, t_step: f64, t: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
+    /// The power per account at `y` and time `t` on a step that starts at `t_step`.
+    fn power(&self, t_step: f64, t: f64, y: &SVector<f64, N>) -> Work;
 }

@@ -135,9 +135,11 @@ impl Vessel {
     /// The tables a vessel file may have: the body's and initial state's, and the components'.
     pub fn tables() -> Vec<&'static str> {
         let mut t = vec!["vessel", "initial"];
-        for (_, table, _) in forces::COMPONENTS {
-            if !t.contains(table) {
-                t.push(table);
+        for (_, tables, _) in forces::COMPONENTS {
+            for table in *tables {
+                if !t.contains(table) {
+                    t.push(table);
+                }
             }
         }
         t

@@ -176,6 +176,89 @@ impl Params {
         Ok(x)
     }
 
+    /// A number, or `None` if absent.
+    pub fn opt_f64(
+        &mut self,
+        section: &str,
+        key: &str,
+        unit: &str,
+        range: Range,
+    ) -> Result<Option<f64>> {
+        let Some(v) = self.raw(section, key)?.cloned() else {
+            return Ok(None);
+        };
+        let x = Self::number(section, key, &v, unit)?;
+        range.check(&format!("{section}.{key}"), x, unit)?;
+        self.record(section, key, Value::Float(x));
+        Ok(Some(x))
+    }
+
+    /// A list of rows of `width` numbers each (`width` 1: a list of numbers), or `None` if
+    /// absent.
+    pub fn rows(
+        &mut self,
+        section: &str,
+        key: &str,
+        width: usize,
+        unit: &str,
+        range: Range,
+    ) -> Result<Option<Vec<Vec<f64>>>> {
+        let Some(v) = self.raw(section, key)?.cloned() else {
+            return Ok(None);
+        };
+        let shape = if width == 1 {
+            "a list of numbers".to_string()
+        } else {
+            format!("a list of rows of {width} numbers")
+        };
+        let Value::Array(a) = &v else {
+            return Err(Error::Parse(format!(
+                "{section}.{key} must be {shape} ({unit}), got {} {v}",
+                v.type_str()
+            )));
+        };
+        let mut out = Vec::with_capacity(a.len());
+        for (i, row) in a.iter().enumerate() {
+            let vals: Vec<f64> = match (width, row) {
+                (1, x) if !x.is_array() => {
+                    vec![Self::number(section, &format!("{key}[{i}]"), x, unit)?]
+                }
+                (w, Value::Array(r)) if w > 1 && r.len() == w => r
+                    .iter()
+                    .enumerate()
+                    .map(|(j, x)| Self::number(section, &format!("{key}[{i}][{j}]"), x, unit))
+                    .collect::<Result<_>>()?,
+                _ => {
+                    return Err(Error::Parse(format!(
+                        "{section}.{key} must be {shape} ({unit}); entry {i} is {row}"
+                    )))
+                }
+            };
+            for (j, x) in vals.iter().enumerate() {
+                let name = if width == 1 {
+                    format!("{section}.{key}[{i}]")
+                } else {
+                    format!("{section}.{key}[{i}][{j}]")
+                };
+                range.check(&name, *x, unit)?;
+            }
+            out.push(vals);
+        }
+        let rec = Value::Array(
+            out.iter()
+                .map(|r| {
+                    if width == 1 {
+                        Value::Float(r[0])
+                    } else {
+                        Value::Array(r.iter().map(|x| Value::Float(*x)).collect())
+                    }
+                })
+                .collect(),
+        );
+        self.record(section, key, rec);
+        Ok(Some(out))
+    }
+
     /// One of `allowed` (the first is the default when absent).
     pub fn choice(
         &mut self,

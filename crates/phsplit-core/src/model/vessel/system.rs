@@ -7,7 +7,7 @@
 //! quadrature all follow from each account's force rows: with `ν = M⁻¹u` the power of a force
 //! `f = F z̄` is the quadratic form `uᵀ M⁻¹ F z̄` of the augmented block state `z̄ = (u, v, w, 1)`.
 
-use super::forces::{Frozen, Rows, S2Builder, Sys};
+use super::forces::{Forcing, Frozen, Output, Rows, S2Builder, Sys};
 use super::state::VesselState;
 use super::Vessel;
 use crate::error::{Error, Result};
@@ -54,6 +54,9 @@ impl LinearFlow {
     }
 }
 
+/// Most fixed-point passes over the forcing of flow S2 in one sub-step.
+const FORCED_MAX_ITERATIONS: usize = 60;
+
 /// Highest order of the sub-flows the vessel provides (Magnus 6, Gauss with 3 stages).
 pub const MAX_SUBFLOW_ORDER: usize = 6;
 
@@ -77,6 +80,9 @@ pub struct VesselSystem<'a> {
     pub project: bool,
     /// Keep the running maxima of the controller's force and moment over every step.
     pub extrema: bool,
+    /// Whether a component has a forcing part (non-affine or time-dependent): flow S2 is then
+    /// integrated by Gauss collocation whatever [`LinearFlow`] says.
+    forced: bool,
 }
 
 impl<'a> VesselSystem<'a> {
@@ -106,7 +112,39 @@ impl<'a> VesselSystem<'a> {
             origin,
             project: true,
             extrema: false,
+            forced: vessel.forces.iter().any(|f| f.forced()),
         }
+    }
+
+    /// Whether flow S2 has a forcing part (a non-affine or time-dependent component), so that
+    /// it is integrated by Gauss collocation whatever the chosen [`LinearFlow`].
+    pub fn is_forced(&self) -> bool {
+        self.forced
+    }
+
+    /// How flow S2 is integrated in this system: the chosen [`LinearFlow`], or Gauss
+    /// collocation when S2 has a forcing part.
+    pub fn s2_solver(&self) -> LinearFlow {
+        if self.forced {
+            LinearFlow::Gauss
+        } else {
+            self.linear
+        }
+    }
+
+    /// The forcing of flow S2 at time `t` and block states `z` (zero without forced
+    /// components).
+    fn forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2]) -> Forcing {
+        let mut g = Forcing::new();
+        if self.forced {
+            for (f, base) in self.vessel.forces.iter().zip(&self.bases) {
+                if f.forced() {
+                    g.base = *base;
+                    f.add_forcing(fr, t, z, &mut g);
+                }
+            }
+        }
+        g
     }
 
     /// The same system keeping (or not) the running maxima of the controller's force and
@@ -243,8 +281,9 @@ impl<'a> VesselSystem<'a> {
         w
     }
 
-    /// The vector field of flow S1 (eq. 40) or S2 (eq. 41) at `s`. Their sum is eq. (39).
-    pub fn split_field(&self, s: &VesselState, on: bool, which: Flow) -> VesselState {
+    /// The vector field of flow S1 (eq. 40) or S2 (eq. 41) at `s` and time `t`. Their sum is
+    /// eq. (39).
+    pub fn split_field(&self, s: &VesselState, t: f64, on: bool, which: Flow) -> VesselState {
         let z = Vector3::zeros();
         match which {
             Flow::S1 => {
@@ -262,7 +301,14 @@ impl<'a> VesselSystem<'a> {
             Flow::S2 => {
                 let b = self.s2_at(&s.q, on, false);
                 let zs = self.blocks_of(s);
-                let [ft, fr] = [b.sys[0].field(&zs[0]), b.sys[1].field(&zs[1])];
+                let [mut ft, mut fr] = [b.sys[0].field(&zs[0]), b.sys[1].field(&zs[1])];
+                if self.forced {
+                    let g = self.forcing(&self.frozen(&s.q, on), t, &zs);
+                    for i in 0..3 {
+                        ft[i] += g.g[0][i];
+                        fr[i] += g.g[1][i];
+                    }
+                }
                 VesselState {
                     p: ft[0],
                     m: fr[0],
@@ -276,9 +322,10 @@ impl<'a> VesselSystem<'a> {
         }
     }
 
-    /// The full vector field, eq. (39): S1's field plus S2's at the current attitude.
-    pub fn vector_field(&self, s: &VesselState, on: bool) -> VesselState {
-        let mut d = self.split_field(s, on, Flow::S2);
+    /// The full vector field, eq. (39), at time `t`: S1's field plus S2's at the current
+    /// attitude.
+    pub fn vector_field(&self, s: &VesselState, t: f64, on: bool) -> VesselState {
+        let mut d = self.split_field(s, t, on, Flow::S2);
         let w = self.vessel.body.free.omega(&s.m);
         d.p -= w.cross(&s.p);
         d.m -= w.cross(&s.m);
@@ -286,22 +333,60 @@ impl<'a> VesselSystem<'a> {
         d
     }
 
-    /// The power per account at `s` (W).
-    pub fn power(&self, s: &VesselState, on: bool) -> Work {
+    /// The power per account at `s` and time `t` (W).
+    pub fn power(&self, s: &VesselState, t: f64, on: bool) -> Work {
         let b = self.s2_at(&s.q, on, true);
-        self.power_at(
-            b.booked.as_ref().expect("built with the ledger"),
-            &self.blocks_of(s),
-        )
+        let z = self.blocks_of(s);
+        let mut w = self.power_at(b.booked.as_ref().expect("built with the ledger"), &z);
+        if self.forced {
+            let g = self.forcing(&self.frozen(&s.q, on), t, &z);
+            w += self.forcing_power(&g, &z);
+        }
+        w
     }
 
-    /// The force (N) and moment (N m) on the body, body frame, of each account at `s`.
-    pub fn account_wrenches(&self, s: &VesselState, on: bool) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    /// The power per account of the forcing `g` at block states `z`: `±(M⁻¹u)·f`.
+    fn forcing_power(&self, g: &Forcing, z: &[Z3; 2]) -> Work {
+        let minv = self.minv();
+        let mut w = Work::default();
+        for k in 0..self.accounts.len() {
+            let mut p = 0.0;
+            for sys in 0..2 {
+                p += z[sys][0].component_mul(&minv[sys]).dot(&g.booked[k][sys]);
+            }
+            w.0[k] = self.sign(k) * p;
+        }
+        w
+    }
+
+    /// The quantities the components report at `s` and time `t` ([`super::forces::Force::outputs`]).
+    pub fn outputs(&self, s: &VesselState, t: f64) -> Vec<Output> {
+        let mut out = Vec::new();
+        for f in &self.vessel.forces {
+            f.outputs(s, t, &mut out);
+        }
+        out
+    }
+
+    /// The force (N) and moment (N m) on the body, body frame, of each account at `s` and
+    /// time `t`.
+    pub fn account_wrenches(
+        &self,
+        s: &VesselState,
+        t: f64,
+        on: bool,
+    ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
         let b = self.s2_at(&s.q, on, true);
         let booked = b.booked.expect("built with the ledger");
         let z = self.blocks_of(s);
+        let g = self.forcing(&self.frozen(&s.q, on), t, &z);
         (0..self.accounts.len())
-            .map(|k| (booked[k][0].at(&z[0]), booked[k][1].at(&z[1])))
+            .map(|k| {
+                (
+                    booked[k][0].at(&z[0]) + g.booked[k][0],
+                    booked[k][1].at(&z[1]) + g.booked[k][1],
+                )
+            })
             .collect()
     }
 
@@ -314,26 +399,167 @@ impl<'a> VesselSystem<'a> {
         s.q = q1;
     }
 
-    /// Flow S2 over `h` (paper §3.4.2): the two block systems at the frozen attitude, by the
-    /// matrix exponential or by Gauss collocation with `stages` stages ([`LinearFlow`]). With
-    /// `ledger`, also the energy booked per account over the sub-step, exactly (Van Loan
-    /// Gramian, or Gauss quadrature of the quadratic power).
+    /// Flow S2 over `h` from time `t` (paper §3.4.2): the two block systems at the frozen
+    /// attitude, by the matrix exponential or by Gauss collocation with `stages` stages
+    /// ([`LinearFlow`]; always collocation when S2 has a forcing part). With `ledger`, also
+    /// the energy booked per account over the sub-step, exactly (Van Loan Gramian, or Gauss
+    /// quadrature of the quadratic power).
     pub fn flow_s2(
         &self,
         s: &mut VesselState,
         h: f64,
+        t: f64,
         on: bool,
         ledger: bool,
         stages: usize,
     ) -> Work {
         let b = self.s2_at(&s.q, on, ledger);
         let z0 = self.blocks_of(s);
-        let (z1, work) = match self.linear {
-            LinearFlow::Gauss => self.gauss_s2(&b, &z0, h, stages),
-            LinearFlow::Exact => self.exact_s2(&b, &z0, h),
+        let (z1, work) = if self.forced {
+            self.forced_gauss_s2(&self.frozen(&s.q, on), &b, &z0, h, t, stages)
+        } else {
+            match self.linear {
+                LinearFlow::Gauss => self.gauss_s2(&b, &z0, h, stages),
+                LinearFlow::Exact => self.exact_s2(&b, &z0, h),
+            }
         };
         self.set_blocks(s, &z1);
         work
+    }
+
+    /// Gauss collocation with `s` stages of flow S2 with a forcing part:
+    /// `z' = Ā z + g(t, z)` on both block systems, `Z_i = z0 + h Σ_j a_ij (Ā Z_j + g(t + c_j h, Z_j))`,
+    /// `z1 = z0 + h Σ_i b_i (Ā Z_i + g_i)`. The linear part is implicit (one LU of the
+    /// balanced `10s × 10s` stage matrix per system), the forcing is iterated to a fixed point
+    /// (it converges at the rate `h² |∂g/∂x| / m`, tiny for the forces of a hull). The ledger
+    /// books each account's power at the stages with the weights `h b_i`, which is exact for
+    /// the collocation polynomial of a quadratic storage (Hairer–Lubich–Wanner, *Geometric
+    /// Numerical Integration*, §IV.2). A system that does not converge, or a singular stage
+    /// matrix, yields a non-finite state (the run then fails with what it had).
+    fn forced_gauss_s2(
+        &self,
+        fr: &Frozen,
+        b: &S2Builder,
+        z0: &[Z3; 2],
+        h: f64,
+        t: f64,
+        s: usize,
+    ) -> ([Z3; 2], Work) {
+        use nalgebra::{DMatrix, DVector};
+        let nan = ([[Vector3::from_element(f64::NAN); 3]; 2], Work::default());
+        let (a, bw) = gauss::tableau(s);
+        let nodes: [f64; 3] = std::array::from_fn(|i| a[i].iter().sum());
+        let minv = self.minv();
+        let n = 10 * s;
+        let mut lus = Vec::with_capacity(2);
+        let mut mats = [SMatrix::<f64, 10, 10>::zeros(); 2];
+        let mut scales = [SVector::<f64, 10>::zeros(); 2];
+        for k in 0..2 {
+            let scale = balance(&b.sys[k], &minv[k]);
+            let abar = b.sys[k].augmented();
+            let at = SMatrix::<f64, 10, 10>::from_fn(|i, j| abar[(i, j)] * scale[j] / scale[i]);
+            let mut m = DMatrix::<f64>::identity(n, n);
+            for i in 0..s {
+                for j in 0..s {
+                    let mut v = m.view_mut((10 * i, 10 * j), (10, 10));
+                    v -= at * (h * a[i][j]);
+                }
+            }
+            lus.push(m.lu());
+            mats[k] = at;
+            scales[k] = scale;
+        }
+        let pack = |z: &Z3, k: usize, one: f64| {
+            let mut out = SVector::<f64, 10>::zeros();
+            for (i, v) in z.iter().enumerate() {
+                out.fixed_rows_mut::<3>(3 * i).copy_from(v);
+            }
+            out[9] = one;
+            out.component_div(&scales[k])
+        };
+        let unpack = |y: &SVector<f64, 10>, k: usize| -> Z3 {
+            let z = y.component_mul(&scales[k]);
+            [
+                z.fixed_rows::<3>(0).into_owned(),
+                z.fixed_rows::<3>(3).into_owned(),
+                z.fixed_rows::<3>(6).into_owned(),
+            ]
+        };
+        let z0t = [pack(&z0[0], 0, 1.0), pack(&z0[1], 1, 1.0)];
+        let mut stage_z = [*z0; 3];
+        let mut ys = [[SVector::<f64, 10>::zeros(); 3]; 2];
+        let mut g = [Forcing::new(); 3];
+        let mut last_change = f64::INFINITY;
+        for it in 0..FORCED_MAX_ITERATIONS {
+            for i in 0..s {
+                g[i] = self.forcing(fr, t + nodes[i] * h, &stage_z[i]);
+            }
+            let mut change: f64 = 0.0;
+            for k in 0..2 {
+                let gt: [SVector<f64, 10>; 3] = std::array::from_fn(|j| {
+                    if j < s {
+                        pack(&g[j].g[k], k, 0.0)
+                    } else {
+                        SVector::zeros()
+                    }
+                });
+                let mut rhs = DVector::<f64>::zeros(n);
+                for i in 0..s {
+                    let mut r = z0t[k];
+                    for j in 0..s {
+                        r += gt[j] * (h * a[i][j]);
+                    }
+                    rhs.rows_mut(10 * i, 10).copy_from(&r);
+                }
+                let Some(y) = lus[k].solve(&rhs) else {
+                    return nan;
+                };
+                for i in 0..s {
+                    let yi = SVector::<f64, 10>::from_iterator(y.rows(10 * i, 10).iter().cloned());
+                    let size = yi.amax().max(f64::MIN_POSITIVE);
+                    change = change.max((yi - ys[k][i]).amax() / size);
+                    ys[k][i] = yi;
+                    stage_z[i][k] = unpack(&yi, k);
+                }
+            }
+            if !change.is_finite() {
+                return nan;
+            }
+            // Converged: the stages no longer move (a forcing independent of the state
+            // converges at the second pass), or they stopped improving at round-off.
+            if it > 0 && (change <= 4.0 * f64::EPSILON || (change >= last_change && change < 1e-12))
+            {
+                break;
+            }
+            if it + 1 == FORCED_MAX_ITERATIONS && change > 1e-10 {
+                return nan;
+            }
+            last_change = change;
+        }
+        for i in 0..s {
+            g[i] = self.forcing(fr, t + nodes[i] * h, &stage_z[i]);
+        }
+        let mut z1 = [[Vector3::zeros(); 3]; 2];
+        for k in 0..2 {
+            let mut y1 = z0t[k];
+            for i in 0..s {
+                y1 += (mats[k] * ys[k][i] + pack(&g[i].g[k], k, 0.0)) * (h * bw[i]);
+            }
+            z1[k] = unpack(&y1, k);
+        }
+        let mut work = Work::default();
+        if let Some(booked) = &b.booked {
+            for i in 0..s {
+                let mut p = self.power_at(booked, &stage_z[i]);
+                p += self.forcing_power(&g[i], &stage_z[i]);
+                work += p.scaled(h * bw[i]);
+            }
+        }
+        let finite = z1.iter().flatten().all(|v| v.iter().all(|x| x.is_finite()));
+        if !finite {
+            return nan;
+        }
+        (z1, work)
     }
 
     /// Gauss collocation on the block systems; the ledger by the Gauss quadrature of the
@@ -473,7 +699,7 @@ impl Model for VesselSystem<'_> {
     }
     /// The norms of the controller's force and moment (its P, I and D accounts together).
     fn probe(&self, t: f64, s: &VesselState, out: &mut [f64]) {
-        let w = self.account_wrenches(s, self.control_on(t));
+        let w = self.account_wrenches(s, t, self.control_on(t));
         let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
         for (a, (fa, ma)) in self.accounts.iter().zip(&w) {
             if a.name == "control" || a.name == "control_damping" {
@@ -506,6 +732,7 @@ impl SplitModel for VesselSystem<'_> {
         which: Flow,
         h: f64,
         t_step: f64,
+        t: f64,
         order: usize,
         ledger: bool,
         s: &mut VesselState,
@@ -518,7 +745,7 @@ impl SplitModel for VesselSystem<'_> {
             }
             Flow::S2 => {
                 let stages = order.div_ceil(2).max(1);
-                self.flow_s2(s, h, self.control_on(t_step), ledger, stages)
+                self.flow_s2(s, h, t, self.control_on(t_step), ledger, stages)
             }
         }
     }
@@ -534,13 +761,19 @@ impl FieldModel<{ super::STATE_DIM }> for VesselSystem<'_> {
     fn rhs(
         &self,
         t_step: f64,
+        t: f64,
         y: &SVector<f64, { super::STATE_DIM }>,
     ) -> SVector<f64, { super::STATE_DIM }> {
-        self.vector_field(&VesselState::from_vector(y), self.control_on(t_step))
+        self.vector_field(&VesselState::from_vector(y), t, self.control_on(t_step))
             .to_vector()
     }
-    fn power(&self, t_step: f64, y: &SVector<f64, { super::STATE_DIM }>) -> Work {
-        VesselSystem::power(self, &VesselState::from_vector(y), self.control_on(t_step))
+    fn power(&self, t_step: f64, t: f64, y: &SVector<f64, { super::STATE_DIM }>) -> Work {
+        VesselSystem::power(
+            self,
+            &VesselState::from_vector(y),
+            t,
+            self.control_on(t_step),
+        )
     }
 }
 
@@ -641,7 +874,7 @@ mod tests {
             let sys = VesselSystem::new(&v, Some(0.0));
             let s = random_state(&v, seed);
             // The full field (eq. 39), written out independently here.
-            let full = sys.vector_field(&s, on).to_vector();
+            let full = sys.vector_field(&s, 0.0, on).to_vector();
             let mv = v.body.mass;
             let vel = s.p / mv;
             let inertia = param(&v, "vessel", "inertia");
@@ -670,18 +903,18 @@ mod tests {
             let scale = expect.norm();
             prop_assert!((full - expect).norm() <= 1e-13 * scale, "field mismatch {}", (full - expect).norm() / scale);
             // The halves of the split add up to the full field.
-            let sum = sys.split_field(&s, on, Flow::S1).to_vector() + sys.split_field(&s, on, Flow::S2).to_vector();
+            let sum = sys.split_field(&s, 0.0, on, Flow::S1).to_vector() + sys.split_field(&s, 0.0, on, Flow::S2).to_vector();
             prop_assert!((sum - full).norm() <= 1e-14 * scale, "S1 + S2 != full: {}", (sum - full).norm() / scale);
             // The exact S2 flow has the S2 field as its derivative at h = 0 (centred difference).
             let e = 1e-3;
             let (mut a, mut b) = (s, s);
-            sys.flow_s2(&mut a, e, on, false, 1);
-            sys.flow_s2(&mut b, -e, on, false, 1);
+            sys.flow_s2(&mut a, e, 0.0, on, false, 1);
+            sys.flow_s2(&mut b, -e, 0.0, on, false, 1);
             let fd = (a.to_vector() - b.to_vector()) / (2.0 * e);
-            let f2 = sys.split_field(&s, on, Flow::S2).to_vector();
+            let f2 = sys.split_field(&s, 0.0, on, Flow::S2).to_vector();
             prop_assert!((fd - f2).norm() <= 1e-6 * f2.norm().max(1.0), "S2 flow vs field {}", (fd - f2).norm() / f2.norm());
             // The power per account, written out: damping and D terms dissipate, P and I supply.
-            let p = sys.power(&s, on);
+            let p = sys.power(&s, 0.0, on);
             let dt = Matrix3::from_diagonal(&param(&v, "vessel", "damping_translational"));
             let dr = Matrix3::from_diagonal(&param(&v, "vessel", "damping_rotational"));
             let expect_p = [
@@ -707,7 +940,7 @@ mod tests {
             let mut s = random_state(&v, seed);
             s.mu.z = 0.0;
             let h0 = v.energy(&s);
-            let w = sys.flow_s2(&mut s, h, true, true, variant.max(1));
+            let w = sys.flow_s2(&mut s, h, 0.0, true, true, variant.max(1));
             let dh = v.energy(&s) - h0;
             let acc = sys.accounts();
             let sup = w.total(acc, AccountKind::Supplied);
@@ -720,6 +953,42 @@ mod tests {
             }
             prop_assert!((dh - (sup - dis)).abs() <= 1e-11 * scale,
                 "dH {dh} supplied {sup} dissipated {dis}");
+        }
+    }
+
+    /// The forced collocation (dense stage solve, forcing iterated) against the structured
+    /// affine one: a set-point table whose only row is the fixed set point adds a forcing that
+    /// is identically zero, so both must give the same flow and ledger to round-off.
+    #[test]
+    fn forced_collocation_with_zero_forcing_is_the_affine_collocation() {
+        let base = Vessel::paper();
+        let xr = param(&base, "control", "position_reference");
+        let er = param(&base, "control", "euler_reference");
+        let text = format!(
+            "{}\n[setpoint]\nnatural_frequency = 0.1\ntimes = [0.0]\npositions = [[{}, {}, {}]]\nheadings = [{}]\n",
+            super::super::PAPER_VESSEL_TOML, xr.x, xr.y, xr.z, er.z
+        );
+        let v = Vessel::from_toml_str(&text).unwrap();
+        let forced = VesselSystem::new(&v, Some(0.0));
+        assert!(forced.is_forced() && forced.s2_solver() == LinearFlow::Gauss);
+        let plain = VesselSystem::new(&base, Some(0.0)).with_linear_flow(LinearFlow::Gauss);
+        for stages in 1..=3 {
+            let s0 = random_state(&base, [0.3, -0.2, 0.5, 0.1, -0.7, 0.2, 0.4, -0.1]);
+            let (mut a, mut b) = (s0, s0);
+            let wa = forced.flow_s2(&mut a, 0.7, 3.0, true, true, stages);
+            let wb = plain.flow_s2(&mut b, 0.7, 3.0, true, true, stages);
+            let (va, vb) = (a.to_vector(), b.to_vector());
+            assert!(
+                (va - vb).norm() <= 1e-12 * vb.norm(),
+                "{stages}: {}",
+                (va - vb).norm() / vb.norm()
+            );
+            for k in 0..3 {
+                assert!(
+                    (wa.0[k] - wb.0[k]).abs() <= 1e-9 * wb.0[k].abs().max(1.0),
+                    "{k}: {wa:?} {wb:?}"
+                );
+            }
         }
     }
 
@@ -743,9 +1012,9 @@ mod tests {
             let sys = VesselSystem::new(&v, None);
             let s = random_state(&v, [0.2, -0.4, 0.6, 0.3, -0.5, 0.1, 0.7, -0.3]);
             let base = Vessel::paper();
-            let d = sys.vector_field(&s, false).to_vector()
+            let d = sys.vector_field(&s, 0.0, false).to_vector()
                 - VesselSystem::new(&base, None)
-                    .vector_field(&s, false)
+                    .vector_field(&s, 0.0, false)
                     .to_vector();
             let (f, m) = (Vector3::new(2e5, -1e5, 3e4), Vector3::new(1e6, 0.0, -2e6));
             let r = Vector3::new(-40.0, 5.0, 3.0);
@@ -766,7 +1035,7 @@ mod tests {
             let vel = s.p / v.body.mass;
             let w = s.m.component_mul(&v.body.inertia_inv);
             let expect = vel.dot(&fb) + w.dot(&(mb + r.cross(&fb)));
-            assert!((sys.power(&s, false).0[k] - expect).abs() < 1e-12 * expect.abs());
+            assert!((sys.power(&s, 0.0, false).0[k] - expect).abs() < 1e-12 * expect.abs());
             let ext = v.force("external").unwrap();
             assert!(format!("{ext:?}").contains("External"));
             let _ = External {

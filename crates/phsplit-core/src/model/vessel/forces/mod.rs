@@ -17,15 +17,21 @@
 //! twice. Flow S1 (the free rigid body, eq. 40) carries no force.
 //!
 //! **Adding a force**: write `forces/<name>.rs` with a `build` function and a type that
-//! implements [`Force`], and add one line to [`COMPONENTS`]. A force that is not affine in
-//! the block states at frozen attitude (nonlinear damping, say) needs a sub-flow of its own:
-//! that extension point is the next step of the model, not part of this contract yet.
+//! implements [`Force`], and add one line to [`COMPONENTS`].
+//!
+//! **Forcing**: a part of a force that is not affine in the block states at frozen attitude
+//! (the pipe's catenary tension as a function of the hang-off point's position), or that
+//! depends on time (a moving set point), is given by [`Force::add_forcing`] instead, as a
+//! value at a time and a block state. A vessel with such a part has flow S2 integrated by
+//! Gauss collocation of the composition's order, with the forcing evaluated at the stages
+//! and their times (docs/model.md §3.7): the ledger then books each account's power at the
+//! stages with the Gauss weights, which for the quadratic storage H closes exactly.
 
 use super::params::Params;
 use super::state::VesselState;
 use super::Body;
 use crate::error::Result;
-use crate::flows::collocation::Blocks;
+use crate::flows::collocation::{Blocks, Z3};
 use crate::solve::{Account, MAX_ACCOUNTS};
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
@@ -35,6 +41,7 @@ pub mod current;
 pub mod damping;
 pub mod external;
 pub mod pid;
+pub mod pipe;
 pub mod restoring;
 
 /// A component's builder: reads its keys, validates them, and returns the component, or `None`
@@ -42,13 +49,14 @@ pub mod restoring;
 pub type Build = fn(&mut Params, &Body) -> Result<Option<Arc<dyn Force>>>;
 
 /// The registration of every component, in the order they are assembled and booked:
-/// its name, the table of the vessel file its keys are in, and its builder.
-pub const COMPONENTS: &[(&str, &str, Build)] = &[
-    ("damping", "vessel", damping::build),
-    ("restoring", "vessel", restoring::build),
-    ("pid", "control", pid::build),
-    ("external", "external", external::build),
-    ("current", "current", current::build),
+/// its name, the tables of the vessel file its keys are in, and its builder.
+pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
+    ("damping", &["vessel"], damping::build),
+    ("restoring", &["vessel"], restoring::build),
+    ("pid", &["control", "setpoint"], pid::build),
+    ("external", &["external"], external::build),
+    ("current", &["current"], current::build),
+    ("pipe", &["pipe"], pipe::build),
 ];
 
 /// The two block systems of flow S2 (paper eq. 41):
@@ -155,6 +163,50 @@ impl S2Builder {
     }
 }
 
+/// The forcing of flow S2 at one time and block state: what the components' non-affine or
+/// time-dependent parts add to the fields of the two block systems, and, per account, the
+/// forces they book.
+#[derive(Debug, Clone, Copy)]
+pub struct Forcing {
+    /// Added to `(u', v', w')` of each block system.
+    pub g: [Z3; 2],
+    /// The booked force on the momentum of each system, per account.
+    pub booked: [[Vector3<f64>; 2]; MAX_ACCOUNTS],
+    /// First account of the component being evaluated.
+    pub(crate) base: usize,
+}
+
+impl Forcing {
+    pub(crate) fn new() -> Self {
+        Self {
+            g: [[Vector3::zeros(); 3]; 2],
+            booked: [[Vector3::zeros(); 2]; MAX_ACCOUNTS],
+            base: 0,
+        }
+    }
+    /// Add a force on the momentum of `sys`, booked to the component's account `account` (its
+    /// index in [`Force::accounts`]), or to none (a conservative exchange between stores of H).
+    pub fn force(&mut self, sys: Sys, account: Option<usize>, f: Vector3<f64>) {
+        self.g[sys as usize][0] += f;
+        if let Some(k) = account {
+            self.booked[self.base + k][sys as usize] += f;
+        }
+    }
+    /// Add to the rate of the third state of `sys` (an integral state).
+    pub fn rate_w(&mut self, sys: Sys, r: Vector3<f64>) {
+        self.g[sys as usize][2] += r;
+    }
+}
+
+/// A named scalar a component reports at a state, for the results (CF units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Output {
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub long_name: &'static str,
+    pub value: f64,
+}
+
 /// A force or port of the vessel. See the module documentation for the contract.
 pub trait Force: Debug + Send + Sync {
     /// The component's name (its registration name).
@@ -166,6 +218,18 @@ pub trait Force: Debug + Send + Sync {
     }
     /// Its part in flow S2 at the frozen attitude.
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder);
+    /// Whether it has a forcing part ([`Force::add_forcing`]): flow S2 is then integrated by
+    /// Gauss collocation.
+    fn forced(&self) -> bool {
+        false
+    }
+    /// Its forcing part at time `t` and block states `z` (translation `(p, x − x_o, phi_x)`,
+    /// rotation `(m, mu, phi_th)`) at the frozen attitude: the part of its force that is not
+    /// affine in `z` or that depends on time.
+    fn add_forcing(&self, _fr: &Frozen, _t: f64, _z: &[Z3; 2], _g: &mut Forcing) {}
+    /// The quantities it reports at state `s` and time `t` (the pipe's top tension, the
+    /// moving set point, …), appended to `out`; the same names at every state.
+    fn outputs(&self, _s: &VesselState, _t: f64, _out: &mut Vec<Output>) {}
     /// Energy it stores, a part of H (J).
     fn storage(&self, _s: &VesselState) -> f64 {
         0.0

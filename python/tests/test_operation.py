@@ -1,0 +1,233 @@
+"""Issue 12 (its first part): the pipe on the stinger as a port, and moving set points through
+Fossen's third-order reference model. References: closed forms (the catenary, solved here with
+mpmath at 30 digits; the filter's step response by partial fractions), a published example
+(MIT OCW 2.019, 2011), the static balance of the controller and the pipe, and the independent
+numpy model (tests/reference.py: the catenary by root finding, the filter integrated as an ODE)
+by DOP853."""
+from __future__ import annotations
+
+import math
+
+import mpmath as mp
+import numpy as np
+import pytest
+
+import phsplit
+import reference as ref
+
+mp.mp.dps = 30
+
+
+def vessel(**tables):
+    d = phsplit.Vessel.paper().to_dict()
+    d.update(tables)
+    return phsplit.Vessel.from_dict(d)
+
+
+def upright(v):
+    """The vessel's initial state, upright and at rest at its set point."""
+    d = v.to_dict()
+    return v.initial_state(euler=[0.0, 0.0, 0.0], position=d["control"]["position_reference"],
+                           velocity=[0.0, 0.0, 0.0], angular_velocity=[0.0, 0.0, 0.0])
+
+
+def hang_off_of(sol, k, r):
+    return sol.x[k] + sol.Q[k] @ np.asarray(r, float)
+
+
+def catenary_mp(w, d, X):
+    """(H, T, s) of the catenary with span X and height d, in mpmath: a acosh(1 + d/a) = X."""
+    w, d, X = mp.mpf(w), mp.mpf(d), mp.mpf(X)
+    a = mp.exp(mp.findroot(lambda la: mp.exp(la) * mp.acosh(1 + d / mp.exp(la)) - X, mp.log(X * X / (2 * d) + d)))
+    s = mp.sqrt(d * d + 2 * a * d)
+    return w * a, w * a + w * d, s
+
+
+# -- the catenary ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("depth,span", [(50.0, 180.0), (300.0, 520.0), (2000.0, 1500.0)])
+def test_catenary_matches_the_closed_form_at_three_depths(depth, span):
+    r = [-60.0, 0.0, 3.0]
+    v0 = vessel()
+    y0 = upright(v0)
+    top = y0[18:21] + np.asarray(r)  # upright: Q = I
+    v = vessel(pipe={"submerged_weight": 1200.0, "water_depth": depth, "hang_off": r,
+                     "touchdown": [float(top[0] - span), float(top[1])]})
+    s = phsplit.simulate(v, (0.0, 1.0), 0.5, "sp2", control_start=None, initial=y0)
+    h_top = hang_off_of(s, 0, r)
+    d = depth + h_top[2]
+    X = math.hypot(h_top[0] - (top[0] - span), h_top[1] - top[1])
+    H, T, sl = (float(q) for q in catenary_mp(1200.0, d, X))
+    got = {k: s.outputs[k][2][0] for k in ("pipe_horizontal_tension", "pipe_top_tension", "pipe_suspended_length")}
+    for name, want in (("pipe_horizontal_tension", H), ("pipe_top_tension", T), ("pipe_suspended_length", sl)):
+        assert abs(got[name] - want) <= 1e-9 * want, (name, got[name], want)
+    # the force on the vessel: H towards the touchdown point, the suspended weight down
+    k = list(s.ledger.by_account).index("pipe")
+    f_spatial = s.Q[0] @ s.account_force[0, k]
+    np.testing.assert_allclose(f_spatial, [-H, 0.0, -1200.0 * sl], rtol=1e-9, atol=1e-6 * H)
+
+
+def test_catenary_reproduces_the_published_example():
+    """MIT OpenCourseWare 2.019 Design of Ocean Systems (Spring 2011), Lecture 13 'Mooring
+    Dynamics (II)', 'Simple Examples': T = 1510 kN, w = 828 N/m, h = 25 m give
+    l_min = 300.93 m, T_H = 1489 kN and x = 300 m (printed to these digits)."""
+    r = [0.0, 0.0, 0.0]
+    v = vessel(pipe={"submerged_weight": 828.0, "water_depth": 25.0, "hang_off": r, "top_tension": 1510e3,
+                     "lay_direction": 0.0})
+    y0 = upright(v)
+    y0[18:21] = [0.0, 0.0, 0.0]
+    s = phsplit.simulate(v, (0.0, 1.0), 0.5, "sp2", control_start=None, initial=y0)
+    o = {k: s.outputs[k][2][0] for k in s.outputs}
+    assert round(o["pipe_suspended_length"], 2) == 300.93
+    assert round(o["pipe_horizontal_tension"] / 1e3) == 1489
+    assert round(-o["pipe_touchdown_x"]) == 300  # the span to the touchdown point, 3 figures
+    assert o["pipe_top_tension"] == pytest.approx(1510e3, rel=1e-15)
+
+
+def test_the_controller_balances_the_pipe_at_rest():
+    """With a constant horizontal tension H along the lay direction and no integral action, the
+    vessel comes to rest where the P term balances it: Kp (x - x_ref) = -H e_lay (closed form,
+    per axis). With the integral action on, it rests on the set point and Ki phi_x carries H."""
+    H, lay = 3.0e5, 30.0
+    e = np.array([math.cos(math.radians(lay)), math.sin(math.radians(lay))])
+    pipe = {"submerged_weight": 900.0, "water_depth": 200.0, "hang_off": [-50.0, 0.0, 2.0],
+            "horizontal_tension": H, "lay_direction": lay}
+    d = phsplit.Vessel.paper().to_dict()
+    d["pipe"] = pipe
+    d["control"] = dict(d["control"], ki_translational=[0.0, 0.0, 0.0], ki_rotational=[0.0, 0.0, 0.0])
+    v = phsplit.Vessel.from_dict(d)
+    kp = np.array(d["control"]["kp_translational"])
+    xr = np.array(d["control"]["position_reference"])
+    s = phsplit.simulate(v, (0.0, 6000.0), 1.0, "sp2", control_start=0.0, save_every=600)
+    np.testing.assert_allclose(kp[:2] * (s.x[-1, :2] - xr[:2]), -H * e, rtol=1e-6)
+    assert np.linalg.norm(s.v[-1]) < 1e-6
+    # with integral action: on the set point, Ki phi_x = -H e
+    v2 = vessel(pipe=pipe)
+    s2 = phsplit.simulate(v2, (0.0, 8000.0), 1.0, "sp2", control_start=0.0, save_every=800)
+    ki = np.array(v2.to_dict()["control"]["ki_translational"])
+    np.testing.assert_allclose(ki[:2] * s2.phi_x[-1, :2], -H * e, rtol=1e-4)
+    assert np.linalg.norm(s2.x[-1, :2] - xr[:2]) < 1e-3
+
+
+# -- the reference model ---------------------------------------------------------------------
+
+@pytest.mark.parametrize("zeta", [0.6, 1.0, 1.7])
+def test_reference_model_step_response_matches_the_closed_form(zeta):
+    """x_d/r = w^3/((s + w)(s^2 + 2 zeta w s + w^2)): the unit step response is
+    1 + sum_k w^3 e^{p_k t} / (p_k prod_{j != k} (p_k - p_j)) over the poles (partial fractions,
+    in mpmath; zeta = 1 has a double pole at -w and is taken as a limit from both sides)."""
+    w, t_step, jump = 0.08, 10.0, 100.0
+    sp = {"natural_frequency": w, "relative_damping": zeta, "interpolation": "step", "times": [0.0, t_step],
+          "positions": [[780.0, 20.0, 0.0], [780.0 + jump, 20.0, 0.0]]}
+    v = vessel(setpoint=sp)
+    ts = np.array([0.0, 5.0, 10.0, 10.5, 13.0, 25.0, 60.0, 150.0, 400.0])
+    s = phsplit.simulate(v, (0.0, 400.0), 0.5, "sp2", control_start=0.0, save_at=ts)
+
+    def closed(t, z):
+        z = mp.mpf(z)
+        poles = [-w, -z * w + mp.sqrt(z * z - 1) * w, -z * w - mp.sqrt(z * z - 1) * w]
+        y = mp.mpf(1)
+        for k, pk in enumerate(poles):
+            den = pk
+            for j, pj in enumerate(poles):
+                if j != k:
+                    den *= pk - pj
+            y += w ** 3 * mp.exp(pk * t) / den
+        return float(mp.re(y))
+
+    for t, got in zip(s.t, s.outputs["setpoint_x"][2]):
+        if t <= t_step:
+            want = 780.0
+        elif zeta == 1.0:
+            want = 780.0 + jump * 0.5 * (closed(t - t_step, 1 + 1e-12) + closed(t - t_step, 1 - 1e-12))
+        else:
+            want = 780.0 + jump * closed(t - t_step, zeta)
+        assert abs(got - want) <= 1e-9 * jump, (t, got, want)
+
+
+# -- the ledger and the orders ---------------------------------------------------------------
+
+def operation_vessel():
+    y_top = upright(vessel())[18:21] + np.array([-60.0, 0.0, 3.0])
+    return vessel(pipe={"submerged_weight": 1500.0, "water_depth": 300.0, "hang_off": [-60.0, 0.0, 3.0],
+                        "touchdown": [float(y_top[0] - 500.0), float(y_top[1] + 30.0)], "lay_speed": 0.5,
+                        "lay_direction": 10.0},
+                  setpoint={"natural_frequency": 0.3, "positions": [[780.0, 20.0, 0.0], [980.0, 55.0, 0.0]],
+                            "headings": [0.1, 0.4], "speed": 2.0})
+
+
+@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
+def test_orders_with_the_pipe_and_a_moving_set_point_against_the_independent_model(method, order):
+    v = operation_vessel()
+    y0 = v.initial_state()
+    y0[0:3] = [2e6, -1e6, 0.0]
+    _, y = ref.solve(v.to_dict(), y0, 2.0, 0.0, rtol=1e-13)
+    pe, xe = y[-1][0:3], y[-1][18:21]
+    hs, errs = 2.0 ** -np.arange(1, 6), []
+    for h in hs:
+        s = phsplit.simulate(v, (0.0, 2.0), h, method, control_start=0.0, ledger=False, initial=y0,
+                             project_invariants=False)
+        errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
+    errs = np.array(errs)
+    keep = errs > 1e-13
+    slope = np.polyfit(np.log(hs[keep]), np.log(errs[keep]), 1)[0]
+    assert abs(slope - order) < 0.2, (slope, errs)
+    s = phsplit.simulate(v, (0.0, 2.0), 2.0 ** -5, method, control_start=0.0, ledger=False, initial=y0)
+    print(method, errs, np.linalg.norm(s.x[-1] - xe))
+    assert np.linalg.norm(s.x[-1] - xe) < (1e-4 if order == 2 else 1e-7)
+
+
+@pytest.mark.parametrize("method", ["lie", "sp2", "sp4", "sp6"])
+def test_the_ledger_books_the_pipe_and_the_controller_and_closes(method):
+    v = operation_vessel()
+    assert ("pipe", "supplied") in v.accounts
+    s = phsplit.simulate(v, (0.0, 120.0), 0.5, method, control_start=5.0)
+    assert np.all(s.ledger.relative_residual() < 1e-10), method
+    assert np.all(s.ledger.dissipated[1:] >= 0)
+    assert np.any(s.ledger.by_account["pipe"][1:] != 0)
+
+
+def test_outputs_reach_the_dataset():
+    v = operation_vessel()
+    s = phsplit.simulate(v, (0.0, 20.0), 0.5, "sp2", control_start=0.0)
+    ds = s.to_xarray()
+    for name, unit in (("pipe_top_tension", "N"), ("pipe_departure_angle", "degree"), ("pipe_touchdown_x", "m"),
+                       ("setpoint_x", "m"), ("setpoint_offset", "m"), ("force_pipe", "N")):
+        assert ds[name].attrs["units"] == unit
+    # the touchdown point moves with the lay at 0.5 m/s along 10 degrees
+    tdx = ds["pipe_touchdown_x"].values
+    assert np.all(np.isfinite(tdx))
+
+
+# -- bad data --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("table,words", [
+    ({"pipe": {"submerged_weight": -10.0, "water_depth": 100.0, "hang_off": [0, 0, 0], "horizontal_tension": 1e5,
+               "lay_direction": 0.0}}, r"pipe.submerged_weight must be > 0 \(N/m\)"),
+    ({"pipe": {"submerged_weight": 10.0, "water_depth": 100.0, "hang_off": [0, 0, 4000.0], "horizontal_tension": 1e5,
+               "lay_direction": 0.0}}, r"pipe.hang_off\[2\] must lie within 1000 m"),
+    ({"pipe": {"submerged_weight": 10.0, "water_depth": 100.0, "hang_off": [0, 0, -150.0], "horizontal_tension": 1e5,
+               "lay_direction": 0.0}}, r"at or below the seabed"),
+    ({"pipe": {"submerged_weight": 10.0, "water_depth": 100.0, "hang_off": [0, 0, 0], "horizontal_tension": 1e5}},
+     r"lay_direction"),
+    ({"pipe": {"submerged_weight": 10.0, "water_depth": 100.0, "hang_off": [0, 0, 0], "horizontal_tension": 1e5,
+               "top_tension": 2e5, "lay_direction": 0.0}}, r"exactly one of .*got horizontal_tension, top_tension"),
+    ({"pipe": {"submerged_weight": 10.0, "water_depth": 100.0, "hang_off": [0, 0, 0], "top_tension": 500.0,
+               "lay_direction": 0.0}}, r"pipe.top_tension must exceed"),
+    ({"pipe": {"submerged_weight": 10.0, "water_depth": 100.0, "hang_off": [0, 0, 0], "departure_angle": 95.0,
+               "lay_direction": 0.0}}, r"departure_angle must lie strictly between 0 and 90"),
+    ({"pipe": {"submerged_weight": 10.0, "water_depth": 100.0, "hang_off": [0, 0, 0], "touchdown": [1.0, 2.0, 3.0]}},
+     r"pipe.touchdown must be 2 numbers"),
+    ({"setpoint": {"natural_frequency": 0.1, "times": [0.0, 0.0], "positions": [[0, 0, 0], [1, 0, 0]]}},
+     r"setpoint.times must increase strictly"),
+    ({"setpoint": {"natural_frequency": 0.1, "times": [0.0], "positions": [[0, 0, 0], [1, 0, 0]]}},
+     r"setpoint.times must have one value per row"),
+    ({"setpoint": {"natural_frequency": 0.1, "positions": [[0, 0, 0], [1, 0, 0]]}}, r"needs times .* or speed"),
+    ({"setpoint": {"natural_frequency": -0.1, "speed": 1.0, "positions": [[0, 0, 0], [1, 0, 0]]}},
+     r"setpoint.natural_frequency must be > 0 \(rad/s\)"),
+    ({"setpoint": {"natural_frequency": 0.1, "speed": 1.0, "positions": [[0, 0], [1, 0]]}},
+     r"setpoint.positions must be a list of rows of 3 numbers"),
+])
+def test_bad_pipe_and_set_point_tables_are_named(table, words):
+    with pytest.raises(phsplit.InvalidInputError, match=words):
+        vessel(**table)
