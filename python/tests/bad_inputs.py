@@ -182,6 +182,17 @@ CATALOGUE: list[Bad] = [
         vessel_with("[initial]", "[setpoint]\nnatural_frequency = 0.05\ntimes = [0.0, 60.0, 30.0]\n"
                     "positions = [[780.0, 20.0, 0.0], [800.0, 20.0, 0.0], [820.0, 20.0, 0.0]]\n[initial]"), E,
         ("setpoint.times", "increase strictly")),
+    Bad("thruster outside the hull",
+        vessel_with("[initial]", "[thrusters]\nhull_length = 83.0\nhull_beam = 18.0\n"
+                    "[[thrusters.unit]]\nkind = \"tunnel\"\nposition = [37.0, 0.0, -3.0]\nmax_thrust = 3e5\n"
+                    "[[thrusters.unit]]\nkind = \"azimuth\"\nposition = [-41.5, 12.0, -3.0]\nmax_thrust = 4.2e5\n"
+                    "[initial]"), E,
+        ("thrusters.unit[1].position[1]", "outside the hull's box")),
+    Bad("thrusters that cannot turn the vessel",
+        vessel_with("[initial]", "[thrusters]\nhull_length = 83.0\nhull_beam = 18.0\n"
+                    "[[thrusters.unit]]\nkind = \"azimuth\"\nposition = [-41.5, 0.0, -3.0]\nmax_thrust = 4.2e5\n"
+                    "[initial]"), E,
+        ("cannot produce surge, sway and yaw", "rank < 3")),
     Bad("set point with both times and a speed",
         vessel_with("[initial]", "[setpoint]\nnatural_frequency = 0.05\ntimes = [0.0, 60.0]\nspeed = 0.5\n"
                     "positions = [[780.0, 20.0, 0.0], [800.0, 20.0, 0.0]]\n[initial]"), E,

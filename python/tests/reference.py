@@ -53,6 +53,8 @@ class Field:
         if ext:
             self.ext = (np.array(ext.get("force", [0.0] * 3), float), np.array(ext.get("moment", [0.0] * 3), float),
                         np.array(ext.get("point", [0.0] * 3), float), ext.get("frame", "body"))
+        thr = params.get("thrusters")
+        self.thr_units = list(thr["unit"]) if thr else None
         pipe = params.get("pipe")
         self.pipe = dict(pipe) if pipe else None
         sp = params.get("setpoint")
@@ -95,6 +97,49 @@ class Field:
         H = w * a
         return np.array([-H * e[0], -H * e[1], -w * s])
 
+    def thrust(self, tau_t, tau_r):
+        """The thrusters' delivered force and moment (body) for the demand (X, Y, N): weighted
+        least-norm allocation B f = tau in the extended thrust formulation, scaled into the
+        limits (docs/model.md 5.8), written again with numpy."""
+        cols, owner, w = [], [], []
+        for i, u in enumerate(self.thr_units):
+            lx, ly = u["position"][0], u["position"][1]
+            if u["kind"] == "azimuth":
+                dirs = [(1.0, 0.0), (0.0, 1.0)]
+            else:
+                a = np.radians(u.get("angle", 90.0 if u["kind"] == "tunnel" else 0.0))
+                dirs = [(np.cos(a), np.sin(a))]
+            for c, s_ in dirs:
+                cols.append([c, s_, lx * s_ - ly * c])
+                owner.append((i, c, s_))
+                w.append(u.get("weight", 1.0))
+        B, Wi = np.array(cols).T, np.diag(1.0 / np.array(w))
+        tau = np.array([tau_t[0], tau_t[1], tau_r[2]])
+        f = Wi @ B.T @ np.linalg.solve(B @ Wi @ B.T, tau)
+        F = np.zeros((len(self.thr_units), 2))
+        for fj, (i, c, s_) in zip(f, owner):
+            F[i] += fj * np.array([c, s_])
+        scale = 1.0
+        for i, u in enumerate(self.thr_units):
+            if u["kind"] == "azimuth":
+                mag = np.hypot(*F[i])
+                if mag > u["max_thrust"]:
+                    scale = min(scale, u["max_thrust"] / mag)
+            else:
+                a = np.radians(u.get("angle", 90.0 if u["kind"] == "tunnel" else 0.0))
+                along = F[i] @ np.array([np.cos(a), np.sin(a)])
+                lo = u.get("min_thrust", -u["max_thrust"])
+                if along > u["max_thrust"]:
+                    scale = min(scale, u["max_thrust"] / along)
+                elif along < lo:
+                    scale = min(scale, lo / along)
+        force, moment = np.zeros(3), np.zeros(3)
+        for i, u in enumerate(self.thr_units):
+            fi = np.array([F[i, 0], F[i, 1], 0.0]) * scale
+            force += fi
+            moment += np.cross(np.array(u["position"], float), fi)
+        return force, moment
+
     def r_of(self, t):
         """The set point (6 channels) and its slope at t: waypoints passed at the given speed."""
         sp = self.sp
@@ -132,6 +177,8 @@ class Field:
                         + K["ki_translational"] @ phx)
         tau_r = -W.T @ (K["kp_rotational"] @ (th - thr) + K["kd_rotational"] @ (W @ w - thd)
                         + K["ki_rotational"] @ phth)
+        if self.thr_units is not None and self.on:
+            tau_t, tau_r = self.thrust(tau_t, tau_r)
         fe, me = self.external(Q)
         if self.pipe is not None:
             fp = Q.T @ self.pipe_force(t, x, Q)

@@ -101,6 +101,18 @@ def test_the_controller_balances_the_pipe_at_rest():
     s = phsplit.simulate(v, (0.0, 6000.0), 1.0, "sp2", control_start=0.0, save_every=600)
     np.testing.assert_allclose(kp[:2] * (s.x[-1, :2] - xr[:2]), -H * e, rtol=1e-6)
     assert np.linalg.norm(s.v[-1]) < 1e-6
+    # through the thrusters: the same rest, and the mean thrust balances the pipe's pull
+    d["thrusters"] = OSV_THRUSTERS
+    vt = phsplit.Vessel.from_dict(d)
+    st = phsplit.simulate(vt, (0.0, 6000.0), 1.0, "sp2", control_start=0.0, save_every=600)
+    # (the offset itself differs from H/Kp by 1e-5 here: the pipe's weight heels the vessel, and
+    # horizontal thrusters do not deliver the demand's component along the tilted body z)
+    np.testing.assert_allclose(kp[:2] * (st.x[-1, :2] - xr[:2]), -H * e, rtol=1e-4)
+    assert np.linalg.norm(st.v[-1]) < 1e-6
+    k = list(st.ledger.by_account).index("thrusters")
+    thrust_spatial = st.Q[-1] @ st.account_force[-1, k]
+    np.testing.assert_allclose(thrust_spatial[:2], H * e, rtol=1e-6)
+    assert st.outputs["thrust_utilisation"][2][-1] < 1.0
     # with integral action: on the set point, Ki phi_x = -H e
     v2 = vessel(pipe=pipe)
     s2 = phsplit.simulate(v2, (0.0, 8000.0), 1.0, "sp2", control_start=0.0, save_every=800)
@@ -147,20 +159,38 @@ def test_reference_model_step_response_matches_the_closed_form(zeta):
 
 # -- the ledger and the orders ---------------------------------------------------------------
 
-def operation_vessel():
+#: The thrusters of the offshore supply vessel of Fossen's MSS (`VESSELS/models/osv.m`, 2024:
+#: two bow tunnel thrusters of 300 kN at x = 37 and 35 m, two stern azimuths of 420 and 655 kN
+#: at x = -L/2 = -41.5 m, y = +-7 m; about midships, L = 83 m, B = 18 m), placed 3 m below the
+#: body origin: a layout for the tests, not the paper's vessel's (the paper gives none).
+OSV_THRUSTERS = {"hull_length": 83.0, "hull_beam": 18.0, "unit": [
+    {"kind": "tunnel", "position": [37.0, 0.0, -3.0], "max_thrust": 300e3},
+    {"kind": "tunnel", "position": [35.0, 0.0, -3.0], "max_thrust": 300e3},
+    {"kind": "azimuth", "position": [-41.5, 7.0, -3.0], "max_thrust": 420e3},
+    {"kind": "azimuth", "position": [-41.5, -7.0, -3.0], "max_thrust": 655e3}]}
+
+
+def operation_vessel(thrusters=False, speed=2.0):
     y_top = upright(vessel())[18:21] + np.array([-60.0, 0.0, 3.0])
+    extra = {"thrusters": OSV_THRUSTERS} if thrusters else {}
     return vessel(pipe={"submerged_weight": 1500.0, "water_depth": 300.0, "hang_off": [-60.0, 0.0, 3.0],
                         "touchdown": [float(y_top[0] - 500.0), float(y_top[1] + 30.0)], "lay_speed": 0.5,
                         "lay_direction": 10.0},
                   setpoint={"natural_frequency": 0.3, "positions": [[780.0, 20.0, 0.0], [980.0, 55.0, 0.0]],
-                            "headings": [0.1, 0.4], "speed": 2.0})
+                            "headings": [0.54, 0.6], "speed": speed}, **extra)
 
 
-@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
-def test_orders_with_the_pipe_and_a_moving_set_point_against_the_independent_model(method, order):
-    v = operation_vessel()
-    y0 = v.initial_state()
-    y0[0:3] = [2e6, -1e6, 0.0]
+@pytest.mark.parametrize("method,order,thrusters", [("sp2", 2, False), ("sp4", 4, False), ("sp2", 2, True),
+                                                    ("sp4", 4, True)])
+def test_orders_with_the_pipe_and_a_moving_set_point_against_the_independent_model(method, order, thrusters):
+    v = operation_vessel(thrusters, speed=0.05 if thrusters else 2.0)
+    if thrusters:
+        # near the set point, so that the thrusters are not saturated (checked below)
+        y0 = v.initial_state(position=[779.0, 19.5, 0.0], euler=[0.05, -0.02, 0.5])
+        y0[0:3] = [2e5, -1e5, 0.0]
+    else:
+        y0 = v.initial_state()
+        y0[0:3] = [2e6, -1e6, 0.0]
     _, y = ref.solve(v.to_dict(), y0, 2.0, 0.0, rtol=1e-13)
     pe, xe = y[-1][0:3], y[-1][18:21]
     hs, errs = 2.0 ** -np.arange(1, 6), []
@@ -173,18 +203,27 @@ def test_orders_with_the_pipe_and_a_moving_set_point_against_the_independent_mod
     slope = np.polyfit(np.log(hs[keep]), np.log(errs[keep]), 1)[0]
     assert abs(slope - order) < 0.2, (slope, errs)
     s = phsplit.simulate(v, (0.0, 2.0), 2.0 ** -5, method, control_start=0.0, ledger=False, initial=y0)
-    print(method, errs, np.linalg.norm(s.x[-1] - xe))
     assert np.linalg.norm(s.x[-1] - xe) < (1e-4 if order == 2 else 1e-7)
+    if thrusters:
+        util = s.outputs["thrust_utilisation"][2]
+        assert np.all(util < 1.0) and util.max() > 0.05, util.max()
 
 
 @pytest.mark.parametrize("method", ["lie", "sp2", "sp4", "sp6"])
-def test_the_ledger_books_the_pipe_and_the_controller_and_closes(method):
-    v = operation_vessel()
+@pytest.mark.parametrize("thrusters", [False, True])
+def test_the_ledger_books_the_pipe_and_the_controller_and_closes(method, thrusters):
+    v = operation_vessel(thrusters)
     assert ("pipe", "supplied") in v.accounts
     s = phsplit.simulate(v, (0.0, 120.0), 0.5, method, control_start=5.0)
     assert np.all(s.ledger.relative_residual() < 1e-10), method
     assert np.all(s.ledger.dissipated[1:] >= 0)
-    assert np.any(s.ledger.by_account["pipe"][1:] != 0)
+    ports = ["pipe", "thrusters"] if thrusters else ["pipe", "control"]
+    for port in ports:
+        assert np.any(s.ledger.by_account[port][1:] != 0), port
+    # each account's own size: the pipe and the thrusters nearly cancel at rest, so the residual
+    # is measured against the terms themselves (Ledger.relative_residual)
+    gross = sum(np.abs(b) for b in s.ledger.by_account.values()) + np.abs(s.ledger.dH)
+    assert np.all(np.abs(s.ledger.residual) <= 1e-10 * gross + 1e-300)
 
 
 def test_outputs_reach_the_dataset():
@@ -197,6 +236,37 @@ def test_outputs_reach_the_dataset():
     # the touchdown point moves with the lay at 0.5 m/s along 10 degrees
     tdx = ds["pipe_touchdown_x"].values
     assert np.all(np.isfinite(tdx))
+
+
+# -- thrusters -------------------------------------------------------------------------------
+
+def test_thrusters_deliver_the_demand_inside_their_capacity_and_its_direction_outside():
+    """The paper's run (80 m off the set point at the start) through the OSV's thrusters: in the
+    transient the demand is tens of times their capacity; later it is inside. Inside: delivered
+    equals commanded to 1e-9. Outside: no thruster beyond its limit, and the delivered (X, Y, N)
+    within 1 degree of the demand's direction."""
+    v = vessel(thrusters=OSV_THRUSTERS)
+    assert ("thrusters", "supplied") in v.accounts and ("control", "supplied") not in v.accounts
+    s = phsplit.simulate(v, (0.0, 1500.0), 0.5, "sp4", control_start=0.0)
+    o = {k: s.outputs[k][2] for k in s.outputs}
+    cmd = np.column_stack([o["commanded_surge"], o["commanded_sway"], o["commanded_yaw"]])
+    dlv = np.column_stack([o["delivered_surge"], o["delivered_sway"], o["delivered_yaw"]])
+    util = o["thrust_utilisation"]
+    inside, outside = util < 1.0 - 1e-12, util >= 1.0 - 1e-12
+    assert inside.sum() > 1000 and outside.sum() > 50, (inside.sum(), outside.sum())
+    err = np.linalg.norm(dlv[inside] - cmd[inside], axis=1) / np.linalg.norm(cmd[inside], axis=1)
+    assert err.max() < 1e-9, err.max()
+    cosang = np.sum(dlv[outside] * cmd[outside], axis=1) / (np.linalg.norm(dlv[outside], axis=1)
+                                                             * np.linalg.norm(cmd[outside], axis=1))
+    assert np.degrees(np.arccos(np.clip(cosang, -1, 1))).max() < 1.0
+    limits = [u["max_thrust"] for u in OSV_THRUSTERS["unit"]]
+    for i, lim in enumerate(limits):
+        assert np.all(np.abs(o[f"thruster{i}_thrust"]) <= lim * (1 + 1e-12))
+    # the ledger books what the thrusters deliver, and closes
+    assert np.all(s.ledger.relative_residual() < 1e-10)
+    # what acts on the vessel is the delivered force: the body force of the thrusters' account
+    k = list(s.ledger.by_account).index("thrusters")
+    np.testing.assert_allclose(s.account_force[:, k, :2], dlv[:, :2], rtol=0, atol=1e-6 * np.abs(dlv).max())
 
 
 # -- bad data --------------------------------------------------------------------------------
@@ -227,7 +297,44 @@ def test_outputs_reach_the_dataset():
      r"setpoint.natural_frequency must be > 0 \(rad/s\)"),
     ({"setpoint": {"natural_frequency": 0.1, "speed": 1.0, "positions": [[0, 0], [1, 0]]}},
      r"setpoint.positions must be a list of rows of 3 numbers"),
+    ({"thrusters": dict(OSV_THRUSTERS, unit=[dict(OSV_THRUSTERS["unit"][0], position=[60.0, 0.0, 0.0])]
+                        + OSV_THRUSTERS["unit"][1:])},
+     r"thrusters.unit\[0\].position\[0\] = 60 m lies outside the hull's box"),
+    ({"thrusters": dict(OSV_THRUSTERS, unit=[dict(OSV_THRUSTERS["unit"][0], kind="pod")] + OSV_THRUSTERS["unit"][1:])},
+     r"thrusters.unit\[0\].kind must be one of 'tunnel', 'azimuth', 'fixed'"),
+    ({"thrusters": dict(OSV_THRUSTERS, unit=[dict(OSV_THRUSTERS["unit"][0], max_thrust=-5.0)] + OSV_THRUSTERS["unit"][1:])},
+     r"thrusters.unit\[0\].max_thrust must be > 0 \(N\)"),
+    ({"thrusters": dict(OSV_THRUSTERS, unit=OSV_THRUSTERS["unit"][:2])}, r"cannot produce surge, sway and yaw"),
+    ({"thrusters": dict(OSV_THRUSTERS, unit=[{"kind": "fixed", "position": [-40.0, 0.0, 0.0], "max_thrust": 1e5,
+                                              "min_thrust": 0.0}] + OSV_THRUSTERS["unit"])},
+     r"thrusters.unit\[0\].min_thrust must be < 0"),
+    ({"thrusters": dict(OSV_THRUSTERS, unit=[dict(OSV_THRUSTERS["unit"][2], angle=30.0)] + OSV_THRUSTERS["unit"][1:])},
+     r"unknown field `angle` in \[thrusters.unit\[0\]\]"),
 ])
 def test_bad_pipe_and_set_point_tables_are_named(table, words):
     with pytest.raises(phsplit.InvalidInputError, match=words):
         vessel(**table)
+
+
+# -- the shipped scenario ----------------------------------------------------------------------
+
+def test_the_shipped_pipelay_scenario_runs_reruns_and_is_cf_compliant(tmp_path, capsys):
+    from phsplit.cli import main
+    from test_results import cf_problems
+
+    assert "pipelay" in phsplit.scenario.shipped()
+    sc = phsplit.load_scenario("pipelay")
+    assert sc.vessel.components == ["damping", "restoring", "pid", "pipe"]
+    assert main(["simulate", "pipelay", "--t-end", "120", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "pipe supplied" in out and "thrusters supplied" in out
+    nc = tmp_path / "pipelay-t120.nc"
+    assert nc.exists() and (tmp_path / "pipelay-t120.png").exists()
+    ds = phsplit.open_dataset(str(nc))
+    for name in ("pipe_top_tension", "pipe_touchdown_x", "thruster3_angle", "thrust_utilisation", "setpoint_offset",
+                 "force_thrusters", "force_pipe"):
+        assert name in ds, name
+    assert cf_problems(nc) == []
+    assert phsplit.results.compare(ds, phsplit.rerun(ds)) == []
+    with pytest.raises(phsplit.InvalidInputError, match="neither a file nor a shipped scenario.*pipelay"):
+        phsplit.load_scenario("pipelya")

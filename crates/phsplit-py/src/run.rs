@@ -188,7 +188,10 @@ fn integrate<'py>(
     if let Some(first) = outputs.first() {
         for (k, o) in first.iter().enumerate() {
             let vals: Vec<f64> = outputs.iter().map(|row| row[k].value).collect();
-            reported.set_item(o.name, (o.unit, o.long_name, PyArray1::from_vec(py, vals)))?;
+            reported.set_item(
+                &o.name,
+                (o.unit, &o.long_name, PyArray1::from_vec(py, vals)),
+            )?;
         }
     }
     d.set_item("outputs", reported)?;

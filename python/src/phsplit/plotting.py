@@ -74,7 +74,10 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     * the horizontal distance to the set point and the heading error (degrees, wrapped);
     * roll and pitch (degrees) and heave z (m);
     * the controller's force (surge, sway; kN) and yaw moment (MN m), body frame;
-    * the stored energy H and the energy booked by each ledger account since the start (MJ).
+    * the stored energy H and the energy booked by each ledger account since the start (MJ);
+    * for an operation (a moving set point, a pipe, thrusters): the desired track and the pipe's
+      touchdown points on the track, the offset from the desired position, and a fourth row with
+      the pipe's top tension and departure angle and the thrusters' thrusts and utilisation.
 
     A dotted line marks the start of the controller."""
     import tomllib
@@ -95,12 +98,21 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     tc = ds.attrs.get("control_start_s", "none")
     tc = None if isinstance(tc, str) else float(tc)
 
-    fig = plt.figure(figsize=(15, 9), layout="constrained")
-    gs = fig.add_gridspec(3, 3)
+    moving = "setpoint_x" in ds
+    piped = "pipe_top_tension" in ds
+    thrust = "thrust_utilisation" in ds
+    rows = 4 if (piped or thrust) else 3
+    fig = plt.figure(figsize=(15, 3 * rows), layout="constrained")
+    gs = fig.add_gridspec(rows, 3)
     ax_track = fig.add_subplot(gs[:, 0])
     ax_track.plot(x[:, 1], x[:, 0], lw=1.2, label="track")
     ax_track.plot(x[0, 1], x[0, 0], "o", color="C2", label="start")
-    if ref_x is not None:
+    if moving:
+        ax_track.plot(ds["setpoint_y"].values, ds["setpoint_x"].values, "k--", lw=1, label="desired (reference model)")
+    if piped:
+        ax_track.plot(ds["pipe_touchdown_y"].values, ds["pipe_touchdown_x"].values, color="C5", lw=1.2,
+                      label="pipe touchdown point")
+    if ref_x is not None and not moving:
         ax_track.plot(ref_x[1], ref_x[0], "k+", ms=14, mew=2, label="set point")
         if watch_circle:
             a = np.linspace(0, 2 * np.pi, 361)
@@ -113,9 +125,15 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     ax_track.legend(fontsize=8, loc="best")
     ax_track.grid(alpha=0.3)
 
-    axes = [fig.add_subplot(gs[i, j]) for i in range(3) for j in (1, 2)]
-    ax_pos, ax_head, ax_rp, ax_heave, ax_ctl, ax_en = axes
-    if ref_x is not None:
+    axes = [fig.add_subplot(gs[i, j]) for i in range(rows) for j in (1, 2)]
+    ax_pos, ax_head, ax_rp, ax_heave, ax_ctl, ax_en = axes[:6]
+    if moving:
+        ax_pos.plot(t, ds["setpoint_offset"].values, lw=1.2)
+        ax_pos.set_ylabel("offset from desired position [m]")
+        err = eul[:, 2] - np.degrees(np.asarray(ds["setpoint_heading"].values))
+        ax_head.plot(t, (err + 180.0) % 360.0 - 180.0, lw=1.2)
+        ax_head.set_ylabel("heading error [deg]")
+    elif ref_x is not None:
         ax_pos.plot(t, np.hypot(x[:, 0] - ref_x[0], x[:, 1] - ref_x[1]), lw=1.2)
         ax_pos.set_ylabel("distance to set point [m]")
         if watch_circle:
@@ -154,11 +172,36 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
                        label=f"{name[7:]} ({kind}, cumulative)")
     ax_en.set_ylabel("energy [MJ]")
     ax_en.legend(fontsize=7)
+    if rows == 4:
+        ax_pipe, ax_thr = axes[6:8]
+        if piped:
+            ax_pipe.plot(t, ds["pipe_top_tension"].values / 1e3, lw=1.2, label="top tension [kN]")
+            ax_pipe.plot(t, ds["pipe_horizontal_tension"].values / 1e3, lw=1.0, label="horizontal tension [kN]")
+            ax_pipe.set_ylabel("pipe tension [kN]")
+            ax_pipe.legend(fontsize=8, loc="center right")
+            ax3 = ax_pipe.twinx()
+            ax3.plot(t, ds["pipe_departure_angle"].values, "C3", lw=1.0)
+            ax3.set_ylabel("departure angle [deg]", color="C3")
+        else:
+            ax_pipe.set_axis_off()
+        if thrust:
+            i = 0
+            while f"thruster{i}_thrust" in ds:
+                ax_thr.plot(t, ds[f"thruster{i}_thrust"].values / 1e3, lw=1.0, label=f"thruster {i} [kN]")
+                i += 1
+            ax_thr.set_ylabel("thrust [kN]")
+            ax_thr.legend(fontsize=7, loc="upper right")
+            ax4 = ax_thr.twinx()
+            ax4.plot(t, ds["thrust_utilisation"].values, "k:", lw=1.0)
+            ax4.set_ylabel("utilisation (dotted)")
+            ax4.set_ylim(0, 1.05)
+        else:
+            ax_thr.set_axis_off()
     for ax in axes:
         ax.grid(alpha=0.3)
         if tc is not None and t[0] <= tc <= t[-1]:
             ax.axvline(tc, color="0.5", ls=":", lw=1)
-    for ax in (ax_ctl, ax_en):
+    for ax in axes[-2:]:
         ax.set_xlabel("t [s]")
     if tc is not None and t[0] <= tc <= t[-1]:
         ax_pos.annotate("controller on", (tc, 1.0), xycoords=("data", "axes fraction"), fontsize=8, color="0.4",

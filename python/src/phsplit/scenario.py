@@ -132,9 +132,32 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
     return Scenario(vessel=vessel, settings=settings, name=name, path=path)
 
 
-def load(path: str | os.PathLike[str]) -> Scenario:
-    """Read and validate a scenario file."""
+#: The scenarios shipped with phsplit (``python/src/phsplit/scenarios``), by name.
+SHIPPED_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios")
+
+
+def shipped() -> list[str]:
+    """The names of the scenarios shipped with phsplit (``phsplit simulate NAME``)."""
+    return sorted(f[:-5] for f in os.listdir(SHIPPED_DIR) if f.endswith(".toml"))
+
+
+def resolve(path: str | os.PathLike[str]) -> str:
+    """A scenario path: ``path`` itself if it is a file or looks like a path, else the shipped
+    scenario of that name."""
     p = os.fspath(path)
+    if os.path.exists(p) or os.sep in p or p.endswith(".toml"):
+        return p
+    if p in shipped():
+        return os.path.join(SHIPPED_DIR, p + ".toml")
+    return p
+
+
+def load(path: str | os.PathLike[str]) -> Scenario:
+    """Read and validate a scenario file, or a shipped scenario by name (``"pipelay"``)."""
+    p = resolve(path)
+    if not os.path.exists(p) and os.fspath(path) == p and os.sep not in p and not p.endswith(".toml"):
+        names = ", ".join(shipped())
+        raise _core.InvalidInputError(f"scenario {p!r} is neither a file nor a shipped scenario (shipped: {names})")
     return from_dict(_read_toml(p, "scenario file"), p)
 
 

@@ -152,8 +152,11 @@ class Ledger:
         return self.dH - (self.supplied - self.dissipated)
 
     def relative_residual(self) -> np.ndarray:
-        """Residual over the size of the terms of each interval's balance."""
-        scale = np.abs(self.dH) + np.abs(self.supplied) + np.abs(self.dissipated)
+        """Residual over the size of the terms of each interval's balance: ``|dH|`` plus each
+        account's ``|booked|`` (two ports that nearly cancel, a pipe pulling against the thrusters,
+        count with their own sizes: floating point cannot resolve their sum better than that)."""
+        booked = sum((np.abs(v) for v in self.by_account.values()), np.zeros_like(self.dH))
+        scale = np.abs(self.dH) + np.maximum(booked, np.abs(self.supplied) + np.abs(self.dissipated))
         with np.errstate(invalid="ignore", divide="ignore"):
             r = np.abs(self.residual) / scale
         return np.where(scale > 0, r, 0.0)
@@ -216,13 +219,13 @@ class Solution:
 
     @property
     def control_force(self) -> np.ndarray:
-        """The controller's force (P, I and D terms), body frame (N, 3), N."""
-        return self.force(*[a for a in ("control", "control_damping") if a in self.ledger.by_account])
+        """The controller's force (P, I and D terms; with thrusters, what they deliver), body frame (N, 3), N."""
+        return self.force(*[a for a in ("control", "control_damping", "thrusters") if a in self.ledger.by_account])
 
     @property
     def control_moment(self) -> np.ndarray:
-        """The controller's moment (P, I and D terms), body frame (N, 3), N m."""
-        return self.moment(*[a for a in ("control", "control_damping") if a in self.ledger.by_account])
+        """The controller's moment (P, I and D terms; with thrusters, what they deliver), body frame (N, 3), N m."""
+        return self.moment(*[a for a in ("control", "control_damping", "thrusters") if a in self.ledger.by_account])
 
     def at(self, times: Sequence[float] | np.ndarray) -> "Solution":
         """Dense output on request: the states at any ``times`` within the run, each computed by

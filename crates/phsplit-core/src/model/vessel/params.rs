@@ -176,6 +176,17 @@ impl Params {
         Ok(x)
     }
 
+    /// The raw value of a key, taken (for a component that reads a nested structure itself,
+    /// validating it and then recording what it used with [`Params::record_value`]).
+    pub fn take_raw(&mut self, section: &str, key: &str) -> Result<Option<Value>> {
+        Ok(self.raw(section, key)?.cloned())
+    }
+
+    /// Record the normalised value of a key read with [`Params::take_raw`].
+    pub fn record_value(&mut self, section: &str, key: &str, v: Value) {
+        self.record(section, key, v);
+    }
+
     /// A number, or `None` if absent.
     pub fn opt_f64(
         &mut self,

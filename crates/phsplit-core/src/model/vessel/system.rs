@@ -362,8 +362,10 @@ impl<'a> VesselSystem<'a> {
     /// The quantities the components report at `s` and time `t` ([`super::forces::Force::outputs`]).
     pub fn outputs(&self, s: &VesselState, t: f64) -> Vec<Output> {
         let mut out = Vec::new();
+        let fr = self.frozen(&s.q, self.control_on(t));
+        let z = self.blocks_of(s);
         for f in &self.vessel.forces {
-            f.outputs(s, t, &mut out);
+            f.outputs(&fr, &z, s, t, &mut out);
         }
         out
     }
@@ -697,12 +699,13 @@ impl Model for VesselSystem<'_> {
             &[]
         }
     }
-    /// The norms of the controller's force and moment (its P, I and D accounts together).
+    /// The norms of the controller's force and moment (its P, I and D accounts together, or what
+    /// its thrusters deliver).
     fn probe(&self, t: f64, s: &VesselState, out: &mut [f64]) {
         let w = self.account_wrenches(s, t, self.control_on(t));
         let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
         for (a, (fa, ma)) in self.accounts.iter().zip(&w) {
-            if a.name == "control" || a.name == "control_damping" {
+            if matches!(a.name, "control" | "control_damping" | "thrusters") {
                 f += fa;
                 m += ma;
             }

@@ -43,6 +43,7 @@ pub mod external;
 pub mod pid;
 pub mod pipe;
 pub mod restoring;
+pub mod thrusters;
 
 /// A component's builder: reads its keys, validates them, and returns the component, or `None`
 /// when the file does not ask for it (an optional component whose table is absent).
@@ -53,7 +54,7 @@ pub type Build = fn(&mut Params, &Body) -> Result<Option<Arc<dyn Force>>>;
 pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("damping", &["vessel"], damping::build),
     ("restoring", &["vessel"], restoring::build),
-    ("pid", &["control", "setpoint"], pid::build),
+    ("pid", &["control", "setpoint", "thrusters"], pid::build),
     ("external", &["external"], external::build),
     ("current", &["current"], current::build),
     ("pipe", &["pipe"], pipe::build),
@@ -199,12 +200,28 @@ impl Forcing {
 }
 
 /// A named scalar a component reports at a state, for the results (CF units).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Output {
-    pub name: &'static str,
+    pub name: String,
     pub unit: &'static str,
-    pub long_name: &'static str,
+    pub long_name: String,
     pub value: f64,
+}
+
+impl Output {
+    pub fn new(
+        name: impl Into<String>,
+        unit: &'static str,
+        long_name: impl Into<String>,
+        value: f64,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            unit,
+            long_name: long_name.into(),
+            value,
+        }
+    }
 }
 
 /// A force or port of the vessel. See the module documentation for the contract.
@@ -227,9 +244,18 @@ pub trait Force: Debug + Send + Sync {
     /// rotation `(m, mu, phi_th)`) at the frozen attitude: the part of its force that is not
     /// affine in `z` or that depends on time.
     fn add_forcing(&self, _fr: &Frozen, _t: f64, _z: &[Z3; 2], _g: &mut Forcing) {}
-    /// The quantities it reports at state `s` and time `t` (the pipe's top tension, the
-    /// moving set point, …), appended to `out`; the same names at every state.
-    fn outputs(&self, _s: &VesselState, _t: f64, _out: &mut Vec<Output>) {}
+    /// The quantities it reports at state `s` (block states `z`, frozen view `fr`) and time
+    /// `t` (the pipe's top tension, the moving set point, the thrusters, …), appended to `out`;
+    /// the same names at every state.
+    fn outputs(
+        &self,
+        _fr: &Frozen,
+        _z: &[Z3; 2],
+        _s: &VesselState,
+        _t: f64,
+        _out: &mut Vec<Output>,
+    ) {
+    }
     /// Energy it stores, a part of H (J).
     fn storage(&self, _s: &VesselState) -> f64 {
         0.0

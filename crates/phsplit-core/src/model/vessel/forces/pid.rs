@@ -27,6 +27,7 @@
 //! times. It is booked with the P and I terms as `control` (the `Kd x_d'` term too: it is a
 //! port term, not dissipation).
 
+use super::thrusters::{self, Thrusters};
 use super::{Force, Forcing, Frozen, Output, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
@@ -52,6 +53,9 @@ pub struct Pid {
     pub position_reference: Vector3<f64>,
     /// The moving set point, if any.
     pub setpoint: Option<Reference>,
+    /// The thrusters that deliver the controller's force, if any (else it acts unlimited, as
+    /// in the paper).
+    pub thrusters: Option<Thrusters>,
 }
 
 /// Table `[control]`: the six gain vectors (≥ 0, SI) and the set point (finite); all required.
@@ -68,8 +72,10 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     let euler_reference = p.vec3("control", "euler_reference", None, "rad", Range::Finite)?;
     let position_reference = p.vec3("control", "position_reference", None, "m", Range::Finite)?;
     let setpoint = setpoint(p, &euler_reference)?;
+    let thrusters = thrusters::read(p)?;
     Ok(Some(Arc::new(Pid {
         setpoint,
+        thrusters,
         kp_translational,
         kd_translational,
         ki_translational,
@@ -191,6 +197,30 @@ const ACCOUNTS: [Account; 2] = [
     },
 ];
 
+/// With thrusters, the controller's whole force is what they deliver: one port.
+const THRUSTER_ACCOUNTS: [Account; 1] = [Account {
+    name: "thrusters",
+    kind: AccountKind::Supplied,
+}];
+
+/// The controller's rows at a frozen attitude: the P and I terms (the port) and the D terms
+/// (the dissipation) of each block system, and the constant parts of the integral states'
+/// rates.
+struct PidRows {
+    port: [Rows; 2],
+    damping: [Rows; 2],
+    /// `x_o − x_ref` (translation) and `θ − θ_ref` at the frozen attitude (rotation).
+    rate: [Vector3<f64>; 2],
+}
+
+/// What a moving set point changes at time `t`: the force and moment it adds to the
+/// controller's (booked with the P and I terms) and what it adds to the integral states' rates.
+struct Moving {
+    force: Vector3<f64>,
+    moment: Vector3<f64>,
+    rate: [Vector3<f64>; 2],
+}
+
 /// `M diag(g)`: column j of `M` times `g_j` (diagonal gains as scalings).
 fn times_diag(m: &Matrix3<f64>, g: &Vector3<f64>) -> Matrix3<f64> {
     let mut out = *m;
@@ -200,16 +230,136 @@ fn times_diag(m: &Matrix3<f64>, g: &Vector3<f64>) -> Matrix3<f64> {
     out
 }
 
+impl Pid {
+    /// The controller's rows at the frozen attitude (paper eqs. 29–33).
+    fn rows(&self, fr: &Frozen) -> PidRows {
+        // Translation, in v = x − x_o: x − x_ref = v + (x_o − x_ref).
+        let qt_kp = times_diag(&fr.qt, &self.kp_translational);
+        let offset = fr.origin - self.position_reference;
+        let port_t = Rows {
+            fv: -qt_kp,
+            fw: -times_diag(&fr.qt, &self.ki_translational),
+            c: -(qt_kp * offset),
+            ..Rows::ZERO
+        };
+        let d_t = times_diag(&fr.qt, &self.kd_translational) * fr.q;
+        let damp_t = Rows {
+            fu: d_t * (-1.0 / fr.body.mass),
+            ..Rows::ZERO
+        };
+        // Rotation.
+        let (theta, wm) = so3::euler_and_w(&fr.q);
+        let theta_err = theta - self.euler_reference;
+        let wt = wm.transpose();
+        let port_r = Rows {
+            fw: -times_diag(&wt, &self.ki_rotational),
+            c: -(wt * self.kp_rotational.component_mul(&theta_err)),
+            ..Rows::ZERO
+        };
+        let d_r = times_diag(&wt, &self.kd_rotational) * wm;
+        let damp_r = Rows {
+            fu: -times_diag(&d_r, &fr.body.inertia_inv),
+            ..Rows::ZERO
+        };
+        PidRows {
+            port: [port_t, port_r],
+            damping: [damp_t, damp_r],
+            rate: [offset, theta_err],
+        }
+    }
+
+    /// What the moving set point changes at `t` (none without one).
+    fn moving(&self, fr: &Frozen, t: f64) -> Option<Moving> {
+        let r = self.setpoint.as_ref()?;
+        let d = r.at(t);
+        let xd = Vector3::new(d.value[0], d.value[1], d.value[2]);
+        let vd = Vector3::new(d.rate[0], d.rate[1], d.rate[2]);
+        let th = Vector3::new(d.value[3], d.value[4], d.value[5]);
+        let thd = Vector3::new(d.rate[3], d.rate[4], d.rate[5]);
+        let dx = xd - self.position_reference;
+        let force = fr.qt
+            * (self.kp_translational.component_mul(&dx) + self.kd_translational.component_mul(&vd));
+        let (_, wm) = so3::euler_and_w(&fr.q);
+        let dth = th - self.euler_reference;
+        let moment = wm.transpose()
+            * (self.kp_rotational.component_mul(&dth) + self.kd_rotational.component_mul(&thd));
+        Some(Moving {
+            force,
+            moment,
+            rate: [-dx, -dth],
+        })
+    }
+
+    /// The controller's demand (force, moment; body frame) at block states `z` and time `t`.
+    pub fn demand(&self, fr: &Frozen, t: f64, z: &[Z3; 2]) -> (Vector3<f64>, Vector3<f64>) {
+        let r = self.rows(fr);
+        let mut f = r.port[0].at(&z[0]) + r.damping[0].at(&z[0]);
+        let mut m = r.port[1].at(&z[1]) + r.damping[1].at(&z[1]);
+        if let Some(mv) = self.moving(fr, t) {
+            f += mv.force;
+            m += mv.moment;
+        }
+        (f, m)
+    }
+}
+
 impl Force for Pid {
     fn name(&self) -> &'static str {
         "pid"
     }
     fn forced(&self) -> bool {
-        self.setpoint.is_some()
+        self.setpoint.is_some() || self.thrusters.is_some()
     }
     /// With a moving set point: the reference model's desired position and heading, and the
-    /// vessel's horizontal distance from the desired position.
-    fn outputs(&self, s: &VesselState, t: f64, out: &mut Vec<Output>) {
+    /// vessel's horizontal distance from the desired position. With thrusters: the demand and
+    /// what they deliver in surge, sway and yaw, each thruster's thrust and angle, and the
+    /// utilisation.
+    fn outputs(&self, fr: &Frozen, z: &[Z3; 2], s: &VesselState, t: f64, out: &mut Vec<Output>) {
+        if let Some(th) = &self.thrusters {
+            let (f, m) = if fr.control_on {
+                self.demand(fr, t, z)
+            } else {
+                (Vector3::zeros(), Vector3::zeros())
+            };
+            let a = th.allocate(&Vector3::new(f.x, f.y, m.z));
+            for (k, (dof, unit)) in [("surge", "N"), ("sway", "N"), ("yaw", "N m")]
+                .iter()
+                .enumerate()
+            {
+                out.push(Output::new(
+                    format!("commanded_{dof}"),
+                    unit,
+                    format!("controller's demand in {dof} (body frame)"),
+                    a.commanded[k],
+                ));
+                out.push(Output::new(
+                    format!("delivered_{dof}"),
+                    unit,
+                    format!("thrust delivered in {dof} (body frame)"),
+                    a.delivered[k],
+                ));
+            }
+            out.push(Output::new(
+                "thrust_utilisation",
+                "1",
+                "largest thrust of a thruster over its limit",
+                a.utilisation,
+            ));
+            for (i, u) in th.units.iter().enumerate() {
+                out.push(Output::new(
+                    format!("thruster{i}_thrust"),
+                    "N",
+                    format!("thrust of thruster {i} ({})", u.kind.name()),
+                    a.thrust[i],
+                ));
+                out.push(Output::new(
+                    format!("thruster{i}_angle"),
+                    "degree",
+                    format!("direction of the force of thruster {i} in the body's x-y plane"),
+                    a.angle[i].to_degrees(),
+                ));
+            }
+        }
         let Some(r) = &self.setpoint else {
             return;
         };
@@ -241,39 +391,42 @@ impl Force for Pid {
                 off,
             ),
         ] {
-            out.push(Output {
-                name,
-                unit,
-                long_name,
-                value,
-            });
+            out.push(Output::new(name, unit, long_name, value));
         }
     }
-    /// The moving set point's part: what `(x_d(t), θ_d(t))` and their rates change in the
-    /// controller's force and in the integral states' rates, against the fixed set point.
-    fn add_forcing(&self, fr: &Frozen, t: f64, _z: &[Z3; 2], g: &mut Forcing) {
-        let (Some(r), true) = (&self.setpoint, fr.control_on) else {
+    /// The moving set point's part (what `(x_d(t), θ_d(t))` and their rates change in the
+    /// controller's force and in the integral states' rates), and, with thrusters, the whole
+    /// force as they deliver it.
+    fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
+        if !fr.control_on {
             return;
-        };
-        let d = r.at(t);
-        let xd = Vector3::new(d.value[0], d.value[1], d.value[2]);
-        let vd = Vector3::new(d.rate[0], d.rate[1], d.rate[2]);
-        let th = Vector3::new(d.value[3], d.value[4], d.value[5]);
-        let thd = Vector3::new(d.rate[3], d.rate[4], d.rate[5]);
-        let dx = xd - self.position_reference;
-        let f = fr.qt
-            * (self.kp_translational.component_mul(&dx) + self.kd_translational.component_mul(&vd));
-        g.force(Sys::Trans, Some(0), f);
-        g.rate_w(Sys::Trans, -dx);
-        let (_, wm) = so3::euler_and_w(&fr.q);
-        let dth = th - self.euler_reference;
-        let m = wm.transpose()
-            * (self.kp_rotational.component_mul(&dth) + self.kd_rotational.component_mul(&thd));
-        g.force(Sys::Rot, Some(0), m);
-        g.rate_w(Sys::Rot, -dth);
+        }
+        let mv = self.moving(fr, t);
+        if let Some(m) = &mv {
+            g.rate_w(Sys::Trans, m.rate[0]);
+            g.rate_w(Sys::Rot, m.rate[1]);
+        }
+        match &self.thrusters {
+            None => {
+                if let Some(m) = mv {
+                    g.force(Sys::Trans, Some(0), m.force);
+                    g.force(Sys::Rot, Some(0), m.moment);
+                }
+            }
+            Some(th) => {
+                let (f, m) = self.demand(fr, t, z);
+                let a = th.allocate(&Vector3::new(f.x, f.y, m.z));
+                g.force(Sys::Trans, Some(0), a.force);
+                g.force(Sys::Rot, Some(0), a.moment);
+            }
+        }
     }
     fn accounts(&self) -> &'static [Account] {
-        &ACCOUNTS
+        if self.thrusters.is_some() {
+            &THRUSTER_ACCOUNTS
+        } else {
+            &ACCOUNTS
+        }
     }
     fn position_origin(&self) -> Option<Vector3<f64>> {
         Some(self.position_reference)
@@ -282,48 +435,17 @@ impl Force for Pid {
         if !fr.control_on {
             return;
         }
-        let (port, damp) = (Some(0), Some(1));
-        // Translation, in v = x − x_o: x − x_ref = v + (x_o − x_ref).
-        let qt_kp = times_diag(&fr.qt, &self.kp_translational);
-        let offset = fr.origin - self.position_reference;
-        let pi = Rows {
-            fv: -qt_kp,
-            fw: -times_diag(&fr.qt, &self.ki_translational),
-            c: -(qt_kp * offset),
-            ..Rows::ZERO
-        };
-        b.force(Sys::Trans, port, &pi);
-        let d_t = times_diag(&fr.qt, &self.kd_translational) * fr.q;
-        b.force(
-            Sys::Trans,
-            damp,
-            &Rows {
-                fu: d_t * (-1.0 / fr.body.mass),
-                ..Rows::ZERO
-            },
-        );
+        let r = self.rows(fr);
+        if self.thrusters.is_none() {
+            let (port, damp) = (Some(0), Some(1));
+            for (k, sys) in [Sys::Trans, Sys::Rot].into_iter().enumerate() {
+                b.force(sys, port, &r.port[k]);
+                b.force(sys, damp, &r.damping[k]);
+            }
+        }
         let t = b.rows(Sys::Trans);
         t.awv += Matrix3::identity();
-        t.cw += offset;
-        // Rotation.
-        let (theta, wm) = so3::euler_and_w(&fr.q);
-        let theta_err = theta - self.euler_reference;
-        let wt = wm.transpose();
-        let pi = Rows {
-            fw: -times_diag(&wt, &self.ki_rotational),
-            c: -(wt * self.kp_rotational.component_mul(&theta_err)),
-            ..Rows::ZERO
-        };
-        b.force(Sys::Rot, port, &pi);
-        let d_r = times_diag(&wt, &self.kd_rotational) * wm;
-        b.force(
-            Sys::Rot,
-            damp,
-            &Rows {
-                fu: -times_diag(&d_r, &fr.body.inertia_inv),
-                ..Rows::ZERO
-            },
-        );
-        b.rows(Sys::Rot).cw += theta_err;
+        t.cw += r.rate[0];
+        b.rows(Sys::Rot).cw += r.rate[1];
     }
 }

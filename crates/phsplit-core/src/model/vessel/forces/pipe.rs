@@ -240,7 +240,7 @@ impl Force for Pipe {
     fn forced(&self) -> bool {
         true
     }
-    fn outputs(&self, s: &VesselState, t: f64, out: &mut Vec<Output>) {
+    fn outputs(&self, _fr: &Frozen, _z: &[Z3; 2], s: &VesselState, t: f64, out: &mut Vec<Output>) {
         let p = self.state_at(&s.x, &s.q, t);
         let c = &p.catenary;
         for (name, unit, long_name, value) in [
@@ -287,12 +287,7 @@ impl Force for Pipe {
                 p.touchdown.y,
             ),
         ] {
-            out.push(Output {
-                name,
-                unit,
-                long_name,
-                value,
-            });
+            out.push(Output::new(name, unit, long_name, value));
         }
     }
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
