@@ -8,7 +8,7 @@ BIN    := $(VENV)/bin
 OUT    ?= out
 RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
 
-.PHONY: run test test-rust test-python build reproduce bench bench-quick fuzz elliptic-refs rigid-body-refs clean
+.PHONY: run test test-rust test-python build reproduce bench bench-quick fuzz elliptic-refs rigid-body-refs capytaine-box clean
 
 run: $(VENV)/.built
 	$(BIN)/phsplit simulate --out $(OUT)
@@ -66,6 +66,13 @@ elliptic-refs: $(VENV)/.deps
 # The mpmath table for the free rigid body (minutes; the table is committed).
 rigid-body-refs: $(VENV)/.deps
 	$(BIN)/python scripts/gen_rigid_body_refs.py
+
+# The stored Capytaine dataset of the tests (python/tests/data/box_barge_capytaine.nc), recomputed
+# with Capytaine in its own environment (it is not a dependency of phsplit).
+capytaine-box:
+	test -x .venv-capytaine/bin/python || $(PYTHON) -m venv .venv-capytaine
+	.venv-capytaine/bin/python -m pip install --quiet "capytaine>=3,<4"
+	.venv-capytaine/bin/python scripts/gen_capytaine_box.py
 
 clean:
 	rm -rf $(VENV) target $(OUT)

@@ -53,6 +53,9 @@ class Field:
         if ext:
             self.ext = (np.array(ext.get("force", [0.0] * 3), float), np.array(ext.get("moment", [0.0] * 3), float),
                         np.array(ext.get("point", [0.0] * 3), float), ext.get("frame", "body"))
+        wv = params.get("waves")
+        self.waves = dict(wv) if wv else None
+        self.g = h["gravity"]
         thr = params.get("thrusters")
         self.thr_units = list(thr["unit"]) if thr else None
         pipe = params.get("pipe")
@@ -96,6 +99,39 @@ class Field:
         s = np.sqrt(d * d + 2 * a * d)
         H = w * a
         return np.array([-H * e[0], -H * e[1], -w * s])
+
+    def wave_loads(self, t, x, Q):
+        """First-order force (6) and drift (surge, sway, yaw) of docs/model.md 5.9, written again:
+        frequency interpolation by np.interp per direction, then periodic np.interp in direction."""
+        wv = self.waves
+        psi = euler_zyx(Q)[2]
+        om, a = np.array(wv["frequencies"], float), np.array(wv["amplitudes"], float)
+        ph, di = np.array(wv["phases"], float), np.radians(np.array(wv["directions"], float))
+        kappa = om ** 2 / self.g
+        # the phase point: the vessel, or the fixed reference (the controller's set point)
+        px = x if wv.get("phase_at", "reference") == "vessel" else self.xr
+        theta = om * t - kappa * (px[0] * np.cos(di) + px[1] * np.sin(di)) + ph
+        rf, rd = np.array(wv["rao_frequencies"], float), np.radians(np.array(wv["rao_directions"], float))
+        tabs = [np.array(wv["force_rao_real"], float), np.array(wv["force_rao_imag"], float)]
+        drift = np.array(wv["drift_coefficients"], float) if "drift_coefficients" in wv else None
+
+        def interp(tab, w, beta):
+            along = np.array([[np.interp(w, rf, tab[i, :, n]) for n in range(tab.shape[2])]
+                              for i in range(tab.shape[0])])
+            if len(rd) == 1:
+                return along[0]
+            return np.array([np.interp(beta, rd, along[:, n], period=2 * np.pi) for n in range(tab.shape[2])])
+
+        first, s, mean = np.zeros(6), np.zeros(3), np.zeros(3)
+        for k in range(len(om)):
+            beta = di[k] - psi
+            re, im = interp(tabs[0], om[k], beta), interp(tabs[1], om[k], beta)
+            first += a[k] * (re * np.cos(theta[k]) - im * np.sin(theta[k]))
+            if drift is not None:
+                d = interp(drift, om[k], beta)
+                s += a[k] * np.sqrt(np.abs(d)) * np.cos(theta[k])
+                mean += a[k] ** 2 * d
+        return first, 2.0 * np.sign(mean) * s ** 2
 
     def thrust(self, tau_t, tau_r):
         """The thrusters' delivered force and moment (body) for the demand (X, Y, N): weighted
@@ -180,6 +216,13 @@ class Field:
         if self.thr_units is not None and self.on:
             tau_t, tau_r = self.thrust(tau_t, tau_r)
         fe, me = self.external(Q)
+        if self.waves is not None:
+            first, dr = self.wave_loads(t, x, Q)
+            psi = euler_zyx(Q)[2]
+            rz = np.array([[np.cos(psi), -np.sin(psi), 0.0], [np.sin(psi), np.cos(psi), 0.0], [0.0, 0.0, 1.0]])
+            tb = Q.T @ rz  # seakeeping frame (heading-aligned, z up) to body
+            fe = fe + tb @ (first[:3] + np.array([dr[0], dr[1], 0.0]))
+            me = me + tb @ (first[3:] + np.array([0.0, 0.0, dr[2]]))
         if self.pipe is not None:
             fp = Q.T @ self.pipe_force(t, x, Q)
             fe, me = fe + fp, me + np.cross(np.array(self.pipe["hang_off"], float), fp)

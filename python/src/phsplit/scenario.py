@@ -23,6 +23,17 @@ settings and the vessel, and names a key nobody reads, with the nearest valid on
     force = [2.0e5, 0.0, 0.0]   # N
     point = [-40.0, 0.0, 5.0]   # m, body frame
     frame = "spatial"           # or "body"
+
+    [environment.current]   # the [current] component
+    velocity = [0.4, 0.0, 0.0]  # m/s, spatial
+
+    [environment.waves]     # a sea state (phsplit.sea), realised with its seed
+    hs = 2.5                    # m
+    tp = 9.0                    # s
+    gamma = 3.3
+    direction = 180.0           # degrees, the direction the waves travel towards
+    seed = 7
+    hydro = "barge.nc"          # a Capytaine dataset: the force transfer functions
 """
 from __future__ import annotations
 
@@ -96,7 +107,7 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
     """A scenario from its parsed tables; ``path`` names the file in messages and resolves a
     relative vessel path."""
     tables = set(_core.vessel_tables())
-    top = {"simulation", "vessel"} | tables | set(allowed_extra)
+    top = {"simulation", "vessel", "environment"} | tables | set(allowed_extra)
     for k in data:
         if k not in top:
             near = difflib.get_close_matches(k, sorted(top), n=1)
@@ -121,6 +132,8 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
     else:
         raise _core.ScenarioParseError(f"{path}: 'vessel' must be a file path or a table, got {v!r}")
     over = {k: val for k, val in data.items() if k in tables and not (k == "vessel" and isinstance(val, str))}
+    if "environment" in data:
+        over = overlay(over, _environment(data["environment"], path, base_dir))
     if over:
         try:
             vessel = Vessel.from_dict(overlay(base.to_dict(), over), f"{source} with the tables of {path}")
@@ -150,6 +163,50 @@ def resolve(path: str | os.PathLike[str]) -> str:
     if p in shipped():
         return os.path.join(SHIPPED_DIR, p + ".toml")
     return p
+
+
+def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
+    """The vessel tables an ``[environment]`` table stands for: ``[environment.current]`` is the
+    ``[current]`` component; ``[environment.waves]`` is a sea state (``phsplit.sea``), realised
+    into the ``[waves]`` component's components, with its transfer functions from a Capytaine
+    dataset (``hydro = "file.nc"``, relative to the scenario; ``symmetric = true`` mirrors a
+    port–starboard symmetric hull's directions) or from the vessel file's own ``[waves]`` keys."""
+    from . import hydro, sea
+
+    if not isinstance(env, Mapping):
+        raise _core.ScenarioParseError(f"{path}: [environment] must be a table")
+    allowed = ("current", "waves")
+    for k, v in env.items():
+        if k not in allowed:
+            near = difflib.get_close_matches(k, allowed, n=1)
+            hint = f"; did you mean {near[0]!r}?" if near else ""
+            raise _core.ScenarioParseError(f"{path}: unknown table [environment.{k}]{hint} (allowed: "
+                                           f"{', '.join(allowed)}; wind is not modelled yet)")
+        if not isinstance(v, Mapping):
+            raise _core.ScenarioParseError(f"{path}: [environment.{k}] must be a table")
+    out: dict[str, Any] = {}
+    if "current" in env:
+        out["current"] = dict(env["current"])
+    if "waves" in env:
+        w = dict(env["waves"])
+        try:
+            comps = sea.sea_state(w).realise()
+        except (_core.ScenarioParseError, _core.InvalidInputError) as e:
+            raise type(e)(f"{path}: {e}") from None
+        table: dict[str, Any] = {}
+        if "hydro" in w:
+            src = w["hydro"]
+            if not isinstance(src, str):
+                raise _core.ScenarioParseError(f"{path}: environment.waves.hydro must be a file path, got {src!r}")
+            p = src if os.path.isabs(src) else os.path.join(base_dir, src)
+            if not os.path.exists(p):
+                raise _core.InvalidInputError(f"{path}: environment.waves.hydro: the Capytaine dataset {p!r} does not exist")
+            try:
+                table = hydro.from_capytaine(p, symmetric=bool(w.get("symmetric", False)))["waves"]
+            except _core.InvalidInputError as e:
+                raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
+        out["waves"] = {**table, **comps}
+    return out
 
 
 def load(path: str | os.PathLike[str]) -> Scenario:

@@ -44,6 +44,7 @@ pub mod pid;
 pub mod pipe;
 pub mod restoring;
 pub mod thrusters;
+pub mod waves;
 
 /// A component's builder: reads its keys, validates them, and returns the component, or `None`
 /// when the file does not ask for it (an optional component whose table is absent).
@@ -58,6 +59,7 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("external", &["external"], external::build),
     ("current", &["current"], current::build),
     ("pipe", &["pipe"], pipe::build),
+    ("waves", &["waves"], waves::build),
 ];
 
 /// The two block systems of flow S2 (paper eq. 41):

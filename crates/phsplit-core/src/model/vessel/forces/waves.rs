@@ -1,0 +1,443 @@
+//! Waves as a port: first-order wave excitation from force transfer functions (force RAOs) and
+//! second-order drift forces by Newman's approximation, on a sea state realised as a sum of
+//! regular components (docs/model.md §5.9).
+//!
+//! Table `[waves]` (optional). The sea state, one entry per component (the Python package
+//! realises them from a spectrum: `phsplit.sea`):
+//! - `frequencies` ω_k (rad/s, > 0), `amplitudes` a_k (m, ≥ 0), `phases` φ_k (rad) and
+//!   `directions` β_k (degrees, the direction the component travels towards, spatial, from
+//!   x towards y).
+//!
+//! The vessel's transfer functions, on a grid of frequencies and directions relative to the
+//! hull (`β − ψ`, ψ the heading; 0 = travelling along the body's x axis, following seas;
+//! 180 = head seas; the grid must go round the circle, it is interpolated periodically):
+//! - `rao_frequencies` (rad/s, increasing, covering every component's frequency) and
+//!   `rao_directions` (degrees, increasing, spanning less than 360);
+//! - `force_rao_real`, `force_rao_imag`: `[direction][frequency][6]`, the complex excitation
+//!   force and moment per metre of wave amplitude (N/m, N m/m; surge, sway, heave, roll, pitch,
+//!   yaw about the body origin, in the seakeeping frame: x along the heading ψ, z up; it follows
+//!   the heading but not the wave-frequency roll and pitch, as linear seakeeping theory assumes,
+//!   so the first-order forces do not rectify into a spurious mean force);
+//! - `drift_coefficients` (optional): `[direction][frequency][3]`, the mean drift force in
+//!   surge and sway and moment in yaw per square metre of amplitude (N/m², N m/m²).
+//!
+//! - `phase_at` (optional): where the components' phases are taken: `"reference"` (the default:
+//!   at a fixed point, the origin of the translational block, i.e. the controller's set point,
+//!   or the spatial origin without a controller: linear seakeeping about a mean position, as in
+//!   the seakeeping frame of Fossen's handbook, §6.6) or `"vessel"` (at the body origin's
+//!   instantaneous position, so that a moving vessel meets the waves at its encounter
+//!   frequency; this also adds a spurious rectified mean force from the first-order phase
+//!   modulation, which the drift coefficients already account for).
+//!
+//! The elevation at the phase point's horizontal position `(x, y)` is
+//! `η = Σ a_k cos θ_k`, `θ_k = ω_k t − κ_k (x cos β_k + y sin β_k) + φ_k`, `κ_k = ω_k²/g`
+//! (deep water). The first-order force is `τ₁ = Σ a_k Re(F(ω_k, β_k − ψ) e^{iθ_k})` (time
+//! convention `e^{+iωt}`; the Capytaine loader conjugates Capytaine's `e^{−iωt}`). The
+//! slowly-varying drift (J. N. Newman, "Second-order, slowly-varying forces on vessels in
+//! irregular waves", 1974) is `τ₂ᵢ = 2 sᵢ (Σ_k a_k √|Dᵢ(ω_k, β_k − ψ)| cos θ_k)²`, with `sᵢ` the
+//! sign of the mean `Σ a_k² Dᵢ`; its mean is `Σ a_k² Dᵢ` when the coefficients keep one sign.
+//!
+//! The forces depend on time and on the position (the phase), so they are a forcing of flow
+//! S2 (Gauss collocation at the stage times, docs/model.md §3.7). Ledger: `waves`
+//! (first order) and `wave_drift` (second order), both supplied: the waves are a source.
+
+use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
+use crate::error::Error;
+use crate::flows::collocation::Z3;
+use crate::lie::so3;
+use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::state::VesselState;
+use crate::solve::{Account, AccountKind};
+use nalgebra::{Vector3, Vector6};
+use std::f64::consts::TAU;
+use std::sync::Arc;
+use toml::Value;
+
+/// One regular component of the sea state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Component {
+    pub omega: f64,
+    pub amplitude: f64,
+    pub phase: f64,
+    /// Direction of travel, rad (spatial).
+    pub direction: f64,
+    /// Deep-water wavenumber `ω²/g`, rad/m.
+    pub wavenumber: f64,
+}
+
+/// A table over (relative direction, frequency) of `N` real or complex values, interpolated
+/// linearly in frequency and periodically in direction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table<const N: usize> {
+    pub frequencies: Vec<f64>,
+    /// Radians, increasing, spanning less than 2π.
+    pub directions: Vec<f64>,
+    /// `[direction][frequency]`.
+    pub re: Vec<Vec<[f64; N]>>,
+    pub im: Vec<Vec<[f64; N]>>,
+}
+
+impl<const N: usize> Table<N> {
+    /// The interpolated (re, im) at `omega` (inside the frequency range) and relative
+    /// direction `beta` (rad, any value).
+    pub fn at(&self, omega: f64, beta: f64) -> ([f64; N], [f64; N]) {
+        let f = &self.frequencies;
+        let j = f
+            .partition_point(|x| *x <= omega)
+            .clamp(1, f.len().max(2) - 1);
+        let (j0, j1) = if f.len() == 1 { (0, 0) } else { (j - 1, j) };
+        let wf = if j0 == j1 {
+            0.0
+        } else {
+            ((omega - f[j0]) / (f[j1] - f[j0])).clamp(0.0, 1.0)
+        };
+        let d = &self.directions;
+        let nd = d.len();
+        let (i0, i1, wd) = if nd == 1 {
+            (0, 0, 0.0)
+        } else {
+            // Wrap beta into [d0, d0 + 2π), then find its interval, the last one closing the circle.
+            let b = d[0] + (beta - d[0]).rem_euclid(TAU);
+            let i = d.partition_point(|x| *x <= b);
+            if i == 0 || i == nd {
+                let (lo, hi) = (d[nd - 1], d[0] + TAU);
+                let bb = if b < d[nd - 1] { b + TAU } else { b };
+                (nd - 1, 0, ((bb - lo) / (hi - lo)).clamp(0.0, 1.0))
+            } else {
+                (
+                    i - 1,
+                    i,
+                    ((b - d[i - 1]) / (d[i] - d[i - 1])).clamp(0.0, 1.0),
+                )
+            }
+        };
+        let mut re = [0.0; N];
+        let mut im = [0.0; N];
+        for (di, wdi) in [(i0, 1.0 - wd), (i1, wd)] {
+            for (fj, wfj) in [(j0, 1.0 - wf), (j1, wf)] {
+                let w = wdi * wfj;
+                if w == 0.0 {
+                    continue;
+                }
+                for n in 0..N {
+                    re[n] += w * self.re[di][fj][n];
+                    im[n] += w * self.im[di][fj][n];
+                }
+            }
+        }
+        (re, im)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Waves {
+    pub components: Vec<Component>,
+    /// Phases at the vessel's instantaneous position (else at the fixed reference point).
+    pub at_vessel: bool,
+    pub force_rao: Table<6>,
+    pub drift: Option<Table<3>>,
+}
+
+fn list(p: &mut Params, key: &str, unit: &str, range: Range) -> crate::Result<Vec<f64>> {
+    Ok(p.rows("waves", key, 1, unit, range)?
+        .ok_or_else(|| Error::Parse(format!("missing field `{key}` in [waves] ({unit})")))?
+        .into_iter()
+        .map(|r| r[0])
+        .collect())
+}
+
+/// A `[direction][frequency][n]` array of finite numbers.
+fn cube(
+    p: &mut Params,
+    key: &str,
+    nd: usize,
+    nf: usize,
+    n: usize,
+    unit: &str,
+    required: bool,
+) -> crate::Result<Option<Vec<Vec<Vec<f64>>>>> {
+    let Some(v) = p.take_raw("waves", key)? else {
+        if required {
+            return Err(Error::Parse(format!(
+                "missing field `{key}` in [waves] ([direction][frequency][{n}] numbers, {unit})"
+            )));
+        }
+        return Ok(None);
+    };
+    let shape = || {
+        Error::InvalidInput(format!(
+            "waves.{key} must be {nd} × {nf} × {n} numbers ([direction][frequency][dof], {unit}), as rao_directions × rao_frequencies"
+        ))
+    };
+    let Value::Array(ds) = &v else {
+        return Err(shape());
+    };
+    if ds.len() != nd {
+        return Err(shape());
+    }
+    let mut out = Vec::with_capacity(nd);
+    for (i, d) in ds.iter().enumerate() {
+        let Value::Array(fs) = d else {
+            return Err(shape());
+        };
+        if fs.len() != nf {
+            return Err(shape());
+        }
+        let mut row = Vec::with_capacity(nf);
+        for (j, f) in fs.iter().enumerate() {
+            let Value::Array(xs) = f else {
+                return Err(shape());
+            };
+            if xs.len() != n {
+                return Err(shape());
+            }
+            let mut vals = Vec::with_capacity(n);
+            for (k, x) in xs.iter().enumerate() {
+                let y = match x {
+                    Value::Float(y) => *y,
+                    Value::Integer(y) => *y as f64,
+                    _ => return Err(shape()),
+                };
+                if !y.is_finite() {
+                    return Err(Error::InvalidInput(format!(
+                        "waves.{key}[{i}][{j}][{k}] must be finite ({unit}), got {y}"
+                    )));
+                }
+                vals.push(y);
+            }
+            row.push(vals);
+        }
+        out.push(row);
+    }
+    p.record_value("waves", key, v);
+    Ok(Some(out))
+}
+
+pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+    const T: &str = "waves";
+    p.declare(T);
+    if !p.has(T) {
+        return Ok(None);
+    }
+    let g = p.f64("vessel", "gravity", "m/s^2", Range::Positive)?;
+    let om = list(p, "frequencies", "rad/s", Range::Positive)?;
+    let am = list(p, "amplitudes", "m", Range::NonNegative)?;
+    let ph = list(p, "phases", "rad", Range::Finite)?;
+    let di = list(p, "directions", "degrees", Range::Finite)?;
+    if om.is_empty() || am.len() != om.len() || ph.len() != om.len() || di.len() != om.len() {
+        return Err(Error::InvalidInput(format!(
+            "waves.frequencies, amplitudes, phases and directions must have one entry per component, and at least one: got {}, {}, {}, {}",
+            om.len(),
+            am.len(),
+            ph.len(),
+            di.len()
+        )));
+    }
+    let rf = list(p, "rao_frequencies", "rad/s", Range::Positive)?;
+    let rd = list(p, "rao_directions", "degrees", Range::Finite)?;
+    if rf.is_empty() || rd.is_empty() {
+        return Err(Error::InvalidInput(
+            "waves.rao_frequencies and waves.rao_directions need at least one value each".into(),
+        ));
+    }
+    for (name, v) in [("rao_frequencies", &rf), ("rao_directions", &rd)] {
+        if let Some(i) = (1..v.len()).find(|&i| v[i] <= v[i - 1]) {
+            return Err(Error::InvalidInput(format!(
+                "waves.{name} must increase strictly: [{i}] = {} after {}",
+                v[i],
+                v[i - 1]
+            )));
+        }
+    }
+    if rd[rd.len() - 1] - rd[0] >= 360.0 {
+        return Err(Error::InvalidInput(format!(
+            "waves.rao_directions must span less than 360 degrees (the grid is periodic), got {} to {}",
+            rd[0],
+            rd[rd.len() - 1]
+        )));
+    }
+    let (lo, hi) = (rf[0], rf[rf.len() - 1]);
+    if let Some(k) = om
+        .iter()
+        .position(|w| *w < lo * (1.0 - 1e-12) || *w > hi * (1.0 + 1e-12))
+    {
+        return Err(Error::InvalidInput(format!(
+            "waves.frequencies[{k}] = {} rad/s lies outside the transfer functions' range waves.rao_frequencies = [{lo}, {hi}] rad/s; extend the data or narrow the spectrum's frequency range",
+            om[k]
+        )));
+    }
+    let at_vessel = p.choice(T, "phase_at", &["reference", "vessel"])? == "vessel";
+    let (nd, nf) = (rd.len(), rf.len());
+    let re = cube(p, "force_rao_real", nd, nf, 6, "N/m, N m/m", true)?.expect("required");
+    let im = cube(p, "force_rao_imag", nd, nf, 6, "N/m, N m/m", true)?.expect("required");
+    let drift = cube(p, "drift_coefficients", nd, nf, 3, "N/m^2, N m/m^2", false)?;
+    let dirs: Vec<f64> = rd.iter().map(|d| d.to_radians()).collect();
+    let to6 = |c: &Vec<Vec<Vec<f64>>>| -> Vec<Vec<[f64; 6]>> {
+        c.iter()
+            .map(|r| r.iter().map(|x| std::array::from_fn(|n| x[n])).collect())
+            .collect()
+    };
+    let force_rao = Table::<6> {
+        frequencies: rf.clone(),
+        directions: dirs.clone(),
+        re: to6(&re),
+        im: to6(&im),
+    };
+    let drift = drift.map(|d| {
+        let re: Vec<Vec<[f64; 3]>> = d
+            .iter()
+            .map(|r| r.iter().map(|x| [x[0], x[1], x[2]]).collect())
+            .collect();
+        Table::<3> {
+            frequencies: rf.clone(),
+            directions: dirs.clone(),
+            im: re.iter().map(|r| vec![[0.0; 3]; r.len()]).collect(),
+            re,
+        }
+    });
+    let components = (0..om.len())
+        .map(|k| Component {
+            omega: om[k],
+            amplitude: am[k],
+            phase: ph[k],
+            direction: di[k].to_radians(),
+            wavenumber: om[k] * om[k] / g,
+        })
+        .collect();
+    Ok(Some(Arc::new(Waves {
+        components,
+        at_vessel,
+        force_rao,
+        drift,
+    })))
+}
+
+const ACCOUNTS: [Account; 2] = [
+    Account {
+        name: "waves",
+        kind: AccountKind::Supplied,
+    },
+    Account {
+        name: "wave_drift",
+        kind: AccountKind::Supplied,
+    },
+];
+
+impl Waves {
+    /// The elevation (m) at the horizontal position `(x, y)` and time `t`.
+    pub fn elevation(&self, x: f64, y: f64, t: f64) -> f64 {
+        self.components
+            .iter()
+            .map(|c| c.amplitude * self.theta(c, x, y, t).cos())
+            .sum()
+    }
+
+    fn theta(&self, c: &Component, x: f64, y: f64, t: f64) -> f64 {
+        c.omega * t - c.wavenumber * (x * c.direction.cos() + y * c.direction.sin()) + c.phase
+    }
+
+    /// The first-order force and moment and the drift `(X, Y, N)` on the body (body frame) at
+    /// horizontal position `(x, y)`, heading `psi` and time `t`.
+    pub fn loads(&self, x: f64, y: f64, psi: f64, t: f64) -> (Vector6<f64>, Vector3<f64>) {
+        let mut first = Vector6::zeros();
+        let mut s = Vector3::<f64>::zeros();
+        let mut mean = Vector3::<f64>::zeros();
+        for c in &self.components {
+            let th = self.theta(c, x, y, t);
+            let (sn, cs) = th.sin_cos();
+            let beta = c.direction - psi;
+            let (re, im) = self.force_rao.at(c.omega, beta);
+            for n in 0..6 {
+                first[n] += c.amplitude * (re[n] * cs - im[n] * sn);
+            }
+            if let Some(d) = &self.drift {
+                let (dv, _) = d.at(c.omega, beta);
+                for n in 0..3 {
+                    s[n] += c.amplitude * dv[n].abs().sqrt() * cs;
+                    mean[n] += c.amplitude * c.amplitude * dv[n];
+                }
+            }
+        }
+        let drift = Vector3::from_fn(|n, _| 2.0 * mean[n].signum() * s[n] * s[n]);
+        (first, drift)
+    }
+}
+
+impl Force for Waves {
+    fn name(&self) -> &'static str {
+        "waves"
+    }
+    fn accounts(&self) -> &'static [Account] {
+        &ACCOUNTS
+    }
+    /// All of the waves' loads are forcing (time and position dependent).
+    fn add_s2(&self, _fr: &Frozen, _b: &mut S2Builder) {}
+    fn forced(&self) -> bool {
+        true
+    }
+    fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
+        let x = if self.at_vessel {
+            fr.origin + z[0][1]
+        } else {
+            fr.origin
+        };
+        let psi = so3::euler_and_w(&fr.q).0.z;
+        let (first, drift) = self.loads(x.x, x.y, psi, t);
+        // The loads are given in the seakeeping frame (x along the heading, z up: it follows the
+        // mean heading, not the oscillations); on the body: Qᵀ R_z(ψ).
+        let to_body = fr.qt * so3::from_euler_zyx(&Vector3::new(0.0, 0.0, psi));
+        g.force(
+            Sys::Trans,
+            Some(0),
+            to_body * Vector3::new(first[0], first[1], first[2]),
+        );
+        g.force(
+            Sys::Rot,
+            Some(0),
+            to_body * Vector3::new(first[3], first[4], first[5]),
+        );
+        if self.drift.is_some() {
+            g.force(
+                Sys::Trans,
+                Some(1),
+                to_body * Vector3::new(drift.x, drift.y, 0.0),
+            );
+            g.force(Sys::Rot, Some(1), to_body * Vector3::new(0.0, 0.0, drift.z));
+        }
+    }
+    fn outputs(&self, fr: &Frozen, _z: &[Z3; 2], s: &VesselState, t: f64, out: &mut Vec<Output>) {
+        let x = if self.at_vessel { s.x } else { fr.origin };
+        out.push(Output::new(
+            "wave_elevation",
+            "m",
+            "wave elevation at the point where the wave phases are taken",
+            self.elevation(x.x, x.y, t),
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn the_table_interpolates_bilinearly_and_round_the_circle() {
+        let t = Table::<1> {
+            frequencies: vec![1.0, 2.0],
+            directions: vec![0.0, PI / 2.0, PI],
+            re: vec![
+                vec![[0.0], [1.0]],
+                vec![[10.0], [11.0]],
+                vec![[20.0], [21.0]],
+            ],
+            im: vec![vec![[0.0], [0.0]]; 3],
+        };
+        assert_eq!(t.at(1.5, 0.0).0[0], 0.5);
+        assert_eq!(t.at(1.0, PI / 4.0).0[0], 5.0);
+        // between π and 2π (= 0): periodic
+        assert!((t.at(1.0, 1.5 * PI).0[0] - 10.0).abs() < 1e-12);
+        assert!((t.at(1.0, -PI / 2.0).0[0] - 10.0).abs() < 1e-12);
+        assert!((t.at(2.0, 2.0 * PI + PI / 2.0).0[0] - 11.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,221 @@
+"""Issue 11 (its second part): waves as a port. References: the target spectrum (wavespectra)
+against an estimate from a 3-hour elevation record; the heave response to a regular wave against
+the closed-form transfer function of the mass-spring-damper; the independent numpy model
+(tests/reference.py, written again from docs/model.md 5.9) by DOP853; the Capytaine dataset read
+independently with xarray."""
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+import pytest
+import xarray as xr
+from scipy.signal import welch
+
+import phsplit
+import reference as ref
+from phsplit import hydro, sea
+
+DATA = os.path.join(os.path.dirname(__file__), "data", "box_barge_capytaine.nc")
+RHO_G = 1025.0 * 9.81
+
+
+def rao_table(scale=1.0, drift=False, omegas=(0.2, 0.6, 1.0, 1.4, 2.0, 3.0)):
+    """Synthetic transfer functions for the paper's vessel, on four directions (0, 90, 180, 270
+    degrees relative to the hull), smooth in frequency: heave force of the order of
+    rho g A_wp, surge and sway a tenth of it, moments with a 20 m arm; phases vary."""
+    nd, nf = 4, len(omegas)
+    awp = 1.3834e3
+    re = np.zeros((nd, nf, 6))
+    im = np.zeros((nd, nf, 6))
+    for i, b in enumerate(np.radians([0.0, 90.0, 180.0, 270.0])):
+        for j, w in enumerate(omegas):
+            decay = math.exp(-0.5 * w)
+            mag = scale * RHO_G * awp * decay * np.array([0.1 * math.cos(b), 0.1 * math.sin(b), 1.0,
+                                                           20.0 * 0.05 * math.sin(b), 20.0 * 0.2 * math.cos(b),
+                                                           20.0 * 0.02 * math.sin(2 * b)])
+            phase = 0.3 * w + 0.1 * i
+            re[i, j] = mag * math.cos(phase)
+            im[i, j] = mag * math.sin(phase)
+    out = {"rao_frequencies": list(omegas), "rao_directions": [0.0, 90.0, 180.0, 270.0],
+           "force_rao_real": re.tolist(), "force_rao_imag": im.tolist()}
+    if drift:
+        d = np.zeros((nd, nf, 3))
+        for i, b in enumerate(np.radians([0.0, 90.0, 180.0, 270.0])):
+            for j, w in enumerate(omegas):
+                d[i, j] = scale * 2e3 * w * np.array([-math.cos(b) - 0.5, -math.sin(b), 3e1 * math.sin(2 * b)])
+        out["drift_coefficients"] = d.tolist()
+    return out
+
+
+def vessel_with_waves(components, scale=1.0, drift=False, **extra):
+    d = phsplit.Vessel.paper().to_dict()
+    d["waves"] = {**rao_table(scale, drift), **components}
+    d.update(extra)
+    return phsplit.Vessel.from_dict(d)
+
+
+def test_a_realised_sea_has_the_target_spectrum():
+    """3 hours of elevation at the vessel: Hs = 4 std(eta) within 2 %, and the peak of a Welch
+    estimate within 5 % of Tp."""
+    ss = sea.SeaState(hs=3.0, tp=9.0, gamma=3.3, seed=11, components=300)
+    v = vessel_with_waves(ss.realise(), scale=0.0)  # a sea that does not move the vessel
+    s = phsplit.simulate(v, (0.0, 10800.0), 0.5, "sp2", control_start=0.0, ledger=False, save_every=1)
+    eta = s.outputs["wave_elevation"][2]
+    assert abs(4.0 * eta.std() - 3.0) / 3.0 < 0.02, 4.0 * eta.std()
+    f, p = welch(eta - eta.mean(), fs=2.0, nperseg=4096)
+    tp_est = 1.0 / f[np.argmax(p)]
+    assert abs(tp_est - 9.0) / 9.0 < 0.05, tp_est
+    # the target, for the record: what wavespectra gives integrates to Hs over the range
+    w = np.linspace(*ss.range(), 2001)
+    assert abs(4 * math.sqrt(np.trapezoid(ss.density(w), w)) - 3.0) < 1e-3
+
+
+def test_the_heave_response_to_a_regular_wave_matches_the_transfer_function():
+    """Controller off, a regular wave: the steady heave amplitude is a |F3| / |c - w^2 m + i w d3|
+    (the paper's vessel has no added mass or wave damping: its own mass and heave damping)."""
+    w, a = 1.1, 1.0
+    v = vessel_with_waves(sea.regular(a, w, direction=180.0), scale=1.0)
+    d = v.to_dict()
+    y0 = v.initial_state(euler=[0.0, 0.0, 0.0], position=[0.0, 0.0, 0.0], velocity=[0.0, 0.0, 0.0],
+                         angular_velocity=[0.0, 0.0, 0.0])
+    s = phsplit.simulate(v, (0.0, 600.0), 0.05, "sp4", control_start=None, initial=y0, save_every=2)
+    tab = np.array(rao_table()["force_rao_real"]) + 1j * np.array(rao_table()["force_rao_imag"])
+    f3 = np.interp(w, rao_table()["rao_frequencies"], np.abs(tab[2, :, 2]))  # head seas: 180 degrees
+    m, d3 = d["vessel"]["mass"], d["vessel"]["damping_translational"][2]
+    c = d["vessel"]["gravity"] * d["vessel"]["water_density"] * d["vessel"]["waterplane_area"]
+    want = a * f3 / abs(c - w * w * m + 1j * w * d3)
+    got = np.abs(s.x[s.t > 400.0, 2]).max()
+    assert abs(got - want) / want < 0.02, (got, want)
+
+
+@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
+def test_orders_with_waves_drift_and_current_against_the_independent_model(method, order):
+    ss = sea.SeaState(hs=2.0, tp=8.0, seed=3, components=25, direction=150.0, spreading=8.0)
+    v = vessel_with_waves(ss.realise(), drift=True, current={"velocity": [0.3, 0.1, 0.0]})
+    y0 = v.initial_state()
+    y0[0:3] = [2e6, -1e6, 0.0]
+    _, y = ref.solve(v.to_dict(), y0, 2.0, 0.0, rtol=1e-13)
+    pe = y[-1][0:3]
+    hs, errs = 2.0 ** -np.arange(1, 6), []
+    for h in hs:
+        s = phsplit.simulate(v, (0.0, 2.0), h, method, control_start=0.0, ledger=False, initial=y0,
+                             project_invariants=False)
+        errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
+    errs = np.array(errs)
+    keep = errs > 1e-13
+    slope = np.polyfit(np.log(hs[keep]), np.log(errs[keep]), 1)[0]
+    assert abs(slope - order) < 0.2, (slope, errs)
+
+
+@pytest.mark.parametrize("method", ["sp2", "sp4"])
+def test_the_ledger_books_each_source_and_closes(method):
+    ss = sea.SeaState(hs=3.0, tp=9.0, seed=5, components=60, direction=200.0)
+    v = vessel_with_waves(ss.realise(), drift=True, current={"velocity": [0.4, -0.2, 0.0]})
+    assert {("waves", "supplied"), ("wave_drift", "supplied"), ("current", "supplied")} <= set(v.accounts)
+    s = phsplit.simulate(v, (0.0, 300.0), 0.5, method, control_start=0.0)
+    assert np.all(s.ledger.relative_residual() < 1e-10)
+    for src in ("waves", "wave_drift", "current", "control"):
+        assert np.any(s.ledger.by_account[src][1:] != 0), src
+    assert np.all(s.ledger.dissipated[1:] >= 0)
+
+
+def test_sp2_stays_within_its_passivity_bound_for_an_hour_at_h_1():
+    """H_n <= H_0 + supplied_n at every step (every dissipation >= 0 and the ledger closed)."""
+    ss = sea.SeaState(hs=4.0, tp=10.0, seed=9, components=100, direction=210.0)
+    v = vessel_with_waves(ss.realise(), drift=True)
+    s = phsplit.simulate(v, (0.0, 3600.0), 1.0, "sp2", control_start=0.0)
+    assert s.status == "completed"
+    supplied = np.cumsum(s.ledger.supplied)
+    scale = np.cumsum(sum(np.abs(b) for b in s.ledger.by_account.values()))
+    assert np.all(s.energy <= s.energy[0] + supplied + 1e-10 * scale + 1e-9)
+    assert np.all(s.ledger.dissipated[1:] >= 0)
+
+
+# -- Capytaine --------------------------------------------------------------------------------
+
+def test_the_capytaine_loader_reproduces_capytaines_values():
+    """The stored dataset (scripts/gen_capytaine_box.py, Capytaine 3.0.0): the loader's added mass
+    and excitation force equal Capytaine's, read here with xarray, exactly (the force as the
+    complex conjugate: e^{-iwt} to e^{+iwt})."""
+    raw = xr.open_dataset(DATA)
+    out = hydro.from_capytaine(DATA)
+    i = int(np.argmax(raw["omega"].values))
+    dofs = ["Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw"]
+    np.testing.assert_array_equal(out["added_mass"],
+                                  raw["added_mass"].isel(omega=i).sel(influenced_dof=dofs, radiating_dof=dofs).values)
+    exc = raw["excitation_force"]
+    for di, beta in enumerate(raw["wave_direction"].values):
+        k = out["waves"]["rao_directions"].index(float(np.degrees(beta)))
+        for fi, w in enumerate(raw["omega"].values):
+            j = out["waves"]["rao_frequencies"].index(float(w))
+            for n, dof in enumerate(dofs):
+                re = float(exc.sel(complex="re", omega=w, wave_direction=beta, influenced_dof=dof))
+                im = float(exc.sel(complex="im", omega=w, wave_direction=beta, influenced_dof=dof))
+                assert out["waves"]["force_rao_real"][k][j][n] == re
+                assert out["waves"]["force_rao_imag"][k][j][n] == -im
+    # mirrored for a symmetric hull: 270 degrees is 90 with sway, roll and yaw reversed
+    sym = hydro.from_capytaine(DATA, symmetric=True)["waves"]
+    a, b = sym["rao_directions"].index(90.0), sym["rao_directions"].index(270.0)
+    np.testing.assert_array_equal(np.array(sym["force_rao_real"][b]),
+                                  np.array(sym["force_rao_real"][a]) * np.array([1, -1, 1, -1, 1, -1]))
+    # and the vessel takes the tables
+    d = phsplit.Vessel.paper().to_dict()
+    d["waves"] = {**sym, **sea.regular(0.5, 1.0, direction=180.0)}
+    phsplit.Vessel.from_dict(d)
+
+
+@pytest.mark.parametrize("drop,words", [(["added_mass"], "lacks added_mass"),
+                                        (["excitation_force", "Froude_Krylov_force"], "lacks excitation_force")])
+def test_a_malformed_capytaine_dataset_names_what_is_missing(drop, words):
+    ds = xr.open_dataset(DATA).drop_vars(drop)
+    with pytest.raises(phsplit.InvalidInputError, match=words):
+        hydro.from_capytaine(ds)
+
+
+# -- scenario and bad tables --------------------------------------------------------------------
+
+def test_a_scenario_with_an_environment(tmp_path, capsys):
+    from phsplit.cli import main
+
+    os.symlink(DATA, tmp_path / "barge.nc")
+    sc = tmp_path / "sea.toml"
+    sc.write_text('[simulation]\nt_span = [0.0, 60.0]\nh = 0.5\nmethod = "sp2"\ncontrol_start = 0.0\n\n'
+                  '[environment.current]\nvelocity = [0.3, 0.0, 0.0]\n\n'
+                  '[environment.waves]\nhs = 2.0\ntp = 8.0\ndirection = 180.0\nseed = 4\ncomponents = 50\n'
+                  'omega_range = [0.35, 1.9]\nhydro = "barge.nc"\nsymmetric = true\n')
+    loaded = phsplit.load_scenario(str(sc))
+    assert loaded.vessel.components[-2:] == ["current", "waves"]
+    assert main(["simulate", str(sc), "--out", str(tmp_path), "--no-plot"]) == 0
+    out = capsys.readouterr().out
+    assert "waves supplied" in out and "current supplied" in out
+    ds = phsplit.open_dataset(str(tmp_path / "sea.nc"))
+    assert "wave_elevation" in ds and "force_waves" in ds
+    # the same seed, the same sea; another seed, another sea
+    again = phsplit.load_scenario(str(sc)).vessel.to_dict()["waves"]["phases"]
+    assert again == loaded.vessel.to_dict()["waves"]["phases"]
+    sc2 = tmp_path / "sea2.toml"
+    sc2.write_text(sc.read_text().replace("seed = 4", "seed = 5"))
+    assert phsplit.load_scenario(str(sc2)).vessel.to_dict()["waves"]["phases"] != again
+
+
+@pytest.mark.parametrize("change,words", [
+    ({"amplitudes": [1.0, 2.0]}, "one entry per component"),
+    ({"frequencies": [5.0]}, r"waves.frequencies\[0\] = 5 rad/s lies outside"),
+    ({"rao_directions": [0.0, 90.0, 180.0, 360.0]}, "span less than 360"),
+    ({"force_rao_real": [[[0.0] * 6] * 6] * 3}, r"waves.force_rao_real must be 4 × 6 × 6 numbers"),
+    ({"rao_frequencies": [0.2, 0.6, 0.6, 1.4, 2.0, 3.0]}, "rao_frequencies must increase strictly"),
+])
+def test_bad_waves_tables_are_named(change, words):
+    d = phsplit.Vessel.paper().to_dict()
+    d["waves"] = {**rao_table(), **sea.regular(1.0, 1.0), **change}
+    with pytest.raises(phsplit.InvalidInputError, match=words):
+        phsplit.Vessel.from_dict(d)
+
+
+@pytest.mark.parametrize("kw,words", [({"hs": -1.0}, "hs must be a number > 0"), ({"spectrum": "bretschneider"},
+                                      "spectrum must be one of"), ({"gamma": 30.0}, r"gamma must lie in \[1, 10\]")])
+def test_bad_sea_states_are_named(kw, words):
+    with pytest.raises(phsplit.InvalidInputError, match=words):
+        sea.SeaState(**{"hs": 2.0, "tp": 8.0, **kw})
