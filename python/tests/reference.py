@@ -67,6 +67,9 @@ class Field:
         cur = params.get("current")
         # a uniform current V_c (spatial): the translational damping acts on v - Q^T V_c
         self.vc = np.array(cur.get("velocity", [0.0] * 3), float) if cur else np.zeros(3)
+        # a slowly varying current: linear between the rows of its time table, constant outside
+        self.vc_table = (np.array(cur["times"], float), np.array(cur["velocities"], float)) \
+            if cur and "times" in cur else None
 
     def external(self, Q):
         """Body-frame force and moment (about the body origin) of the constant external load."""
@@ -229,7 +232,9 @@ class Field:
         dy = np.empty(n)
         if n == 45:
             dy[27:45] = np.concatenate([f[1], f[2], jerk])
-        dy[0:3] = -np.cross(w, p) - (self.Dt * (v - Q.T @ self.vc) + Q.T @ (self.lam * x) - tau_t) + fe
+        vc = self.vc if self.vc_table is None else np.array(
+            [np.interp(t, self.vc_table[0], self.vc_table[1][:, i]) for i in range(3)])
+        dy[0:3] = -np.cross(w, p) - (self.Dt * (v - Q.T @ vc) + Q.T @ (self.lam * x) - tau_t) + fe
         dy[3:6] = -np.cross(w, m) - (self.Dr * w + np.cross(mu, q3) - tau_r) + me
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)

@@ -77,7 +77,7 @@ def test_the_ledger_books_the_current_as_a_port_and_closes():
 def test_bad_current_tables():
     base = phsplit.Vessel.paper().to_dict()
     for table, words in (({"velocity": [1.0, 2.0]}, "3 numbers"), ({"velocity": [0.0, float("nan"), 0.0]}, "finite"),
-                         ({"velocity": [12.0, 0.0, 0.0]}, "10 m/s"), ({"speed": 1.0}, "unknown field `speed` in \[current\] \(allowed: velocity\)")):
+                         ({"velocity": [12.0, 0.0, 0.0]}, "10 m/s"), ({"speed": 1.0}, r"unknown field `speed` in \[current\] \(allowed: times, velocities, velocity\)")):
         d = dict(base, current=table)
         with pytest.raises(phsplit.InvalidInputError, match=words):
             phsplit.Vessel.from_dict(d)
@@ -92,3 +92,50 @@ def test_a_scenario_file_adds_a_current(tmp_path, capsys):
     assert main(["simulate", str(sc), "--out", str(tmp_path), "--no-plot"]) == 0
     out = capsys.readouterr().out
     assert "current supplied" in out and "components: damping, restoring, pid, current" in out
+
+
+def with_current_table():
+    d = phsplit.Vessel.paper().to_dict()
+    d["current"] = {"times": [0.0, 1.0, 600.0], "velocities": [[0.0, 0.0, 0.0], [0.2, -0.1, 0.0], [0.5, 0.2, 0.0]]}
+    return phsplit.Vessel.from_dict(d)
+
+
+def test_a_current_time_table_drifts_the_vessel_to_its_last_row():
+    """After the table's last row the current stays there: controller off, the spatial velocity
+    tends to it (closed form, as for a constant current)."""
+    s = phsplit.simulate(with_current_table(), (0.0, 6000.0), 0.5, "sp2", control_start=None, save_every=200)
+    vel = np.einsum("ij,j->i", s.Q[-1], s.v[-1])
+    np.testing.assert_allclose(vel[:2], [0.5, 0.2], rtol=0, atol=1e-9)
+    assert np.all(s.ledger.relative_residual() < 1e-10)
+
+
+@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
+def test_orders_with_a_current_time_table_against_the_independent_model(method, order):
+    """The table shifted by -0.2 s: its rows at -0.2, 0.8 and 599.8 s. The current's slope jumps at
+    0.8 s, which h = 0.8 / 2^k puts on the step grid (a kink inside a step would cost order)."""
+    v = with_current_table()
+    y0 = v.initial_state()
+    y0[0:3] = [2e6, -1e6, 0.0]
+    d = v.to_dict()
+    d["current"] = {"times": [t - 0.2 for t in d["current"]["times"]], "velocities": d["current"]["velocities"]}
+    _, y = ref.solve(d, y0, 2.0, 0.0, rtol=1e-13)
+    pe = y[-1][0:3]
+    hs, errs = 0.8 / 2.0 ** np.arange(0, 5), []
+    for h in hs:
+        s = phsplit.simulate(phsplit.Vessel.from_dict(d), (0.0, 2.0), h, method, control_start=0.0, ledger=False,
+                             initial=y0, project_invariants=False)
+        errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
+    errs = np.array(errs)
+    keep = errs > 1e-13
+    slope = np.polyfit(np.log(hs[keep]), np.log(errs[keep]), 1)[0]
+    assert abs(slope - order) < 0.2, (slope, errs)
+
+
+def test_bad_current_time_tables():
+    base = phsplit.Vessel.paper().to_dict()
+    for table, words in (({"times": [0.0, 1.0]}, "needs both"),
+                         ({"times": [0.0, 0.0], "velocities": [[0, 0, 0], [1, 0, 0]]}, "increase strictly"),
+                         ({"times": [0.0], "velocities": [[12.0, 0, 0]]}, r"current.velocities\[0\]\[0\] must be within"),
+                         ({"times": [0.0], "velocities": [[1.0, 0, 0]], "velocity": [1.0, 0, 0]}, "not both")):
+        with pytest.raises(phsplit.InvalidInputError, match=words):
+            phsplit.Vessel.from_dict(dict(base, current=table))

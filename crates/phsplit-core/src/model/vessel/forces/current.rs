@@ -13,9 +13,17 @@
 //! enters flow S2 as an affine term, exactly solvable, and its power `v·D_t Qᵀ V_c` is booked
 //! as the work of the port `current` (supplied; it is negative when the vessel moves against
 //! the current faster than the current would carry it). The ledger closes as before.
+//!
+//! **A slowly varying current** (a time table): instead of `velocity`, `times` (s, increasing)
+//! and `velocities` (one row of 3 numbers per time, m/s, spatial): the current moves linearly
+//! between the rows and stays at the first and last row outside them. It is then a forcing of
+//! flow S2 in time (Gauss collocation at the stage times, docs/model.md §3.7), booked as
+//! before. (A time-varying current also accelerates the water around a vessel with added mass;
+//! the paper's vessel has none, so the relative-velocity damping is again the whole load.)
 
-use super::{Force, Frozen, Rows, S2Builder, Sys};
+use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
+use crate::flows::collocation::Z3;
 use crate::model::vessel::params::{Params, Range};
 use crate::solve::{Account, AccountKind};
 use nalgebra::Vector3;
@@ -26,8 +34,10 @@ pub const MAX_SPEED: f64 = 10.0;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Current {
-    /// `V_c`, spatial frame, m/s.
+    /// `V_c`, spatial frame, m/s (the constant current, or the table's first row).
     pub velocity: Vector3<f64>,
+    /// The time table `(t, V_c)`, if the current varies.
+    pub table: Option<(Vec<f64>, Vec<Vector3<f64>>)>,
     /// Diagonal of the translational damping `D_t` (kg/s), the vessel's.
     pub damping: Vector3<f64>,
 }
@@ -38,13 +48,59 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     if !p.has(T) {
         return Ok(None);
     }
-    let velocity = p.vec3(
-        T,
-        "velocity",
-        Some([0.0; 3]),
-        "m/s, spatial frame",
-        Range::Finite,
-    )?;
+    let times = p.rows(T, "times", 1, "s", Range::Finite)?;
+    let rows = p.rows(T, "velocities", 3, "m/s, spatial frame", Range::Finite)?;
+    let table = match (times, rows) {
+        (None, None) => None,
+        (Some(t), Some(v)) => {
+            if t.is_empty() || t.len() != v.len() {
+                return Err(Error::InvalidInput(format!(
+                    "current.times and current.velocities must have one entry per row, and at least one: got {} times and {} velocities",
+                    t.len(),
+                    v.len()
+                )));
+            }
+            let t: Vec<f64> = t.into_iter().map(|r| r[0]).collect();
+            if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
+                return Err(Error::InvalidInput(format!(
+                    "current.times must increase strictly (s): times[{i}] = {} after {}",
+                    t[i],
+                    t[i - 1]
+                )));
+            }
+            for (k, r) in v.iter().enumerate() {
+                for (i, x) in r.iter().enumerate() {
+                    if x.abs() > MAX_SPEED {
+                        return Err(Error::InvalidInput(format!(
+                            "current.velocities[{k}][{i}] must be within ±{MAX_SPEED} m/s (m/s, spatial frame), got {x}"
+                        )));
+                    }
+                }
+            }
+            Some((t, v.into_iter().map(|r| Vector3::new(r[0], r[1], r[2])).collect::<Vec<_>>()))
+        }
+        _ => {
+            return Err(Error::InvalidInput(
+                "a current time table needs both current.times (s) and current.velocities (rows of 3 numbers, m/s)".into(),
+            ))
+        }
+    };
+    let velocity = if let Some((_, v)) = &table {
+        if p.take_raw(T, "velocity")?.is_some() {
+            return Err(Error::InvalidInput(
+                "[current] takes either velocity (a constant current) or times and velocities (a time table), not both".into(),
+            ));
+        }
+        [v[0].x, v[0].y, v[0].z]
+    } else {
+        p.vec3(
+            T,
+            "velocity",
+            Some([0.0; 3]),
+            "m/s, spatial frame",
+            Range::Finite,
+        )?
+    };
     for (i, v) in velocity.iter().enumerate() {
         if v.abs() > MAX_SPEED {
             return Err(Error::InvalidInput(format!(
@@ -61,6 +117,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     )?;
     Ok(Some(Arc::new(Current {
         velocity: velocity.into(),
+        table,
         damping: damping.into(),
     })))
 }
@@ -71,9 +128,25 @@ const ACCOUNTS: [Account; 1] = [Account {
 }];
 
 impl Current {
-    /// The body-frame force of the current at attitude `Qᵀ = qt`: `D_t Qᵀ V_c`.
+    /// The body-frame force of the constant current at attitude `Qᵀ = qt`: `D_t Qᵀ V_c`.
     pub fn body_force(&self, qt: &nalgebra::Matrix3<f64>) -> Vector3<f64> {
         self.damping.component_mul(&(qt * self.velocity))
+    }
+
+    /// The current at time `t` (m/s, spatial).
+    pub fn velocity_at(&self, t: f64) -> Vector3<f64> {
+        let Some((ts, vs)) = &self.table else {
+            return self.velocity;
+        };
+        let k = ts.partition_point(|x| *x <= t);
+        if k == 0 {
+            return vs[0];
+        }
+        if k == ts.len() {
+            return vs[k - 1];
+        }
+        let w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+        vs[k - 1] * (1.0 - w) + vs[k] * w
     }
 }
 
@@ -85,10 +158,23 @@ impl Force for Current {
         &ACCOUNTS
     }
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
-        b.force(
+        if self.table.is_none() {
+            b.force(
+                Sys::Trans,
+                Some(0),
+                &Rows::constant(self.body_force(&fr.qt)),
+            );
+        }
+    }
+    fn forced(&self) -> bool {
+        self.table.is_some()
+    }
+    fn add_forcing(&self, fr: &Frozen, t: f64, _z: &[Z3; 2], g: &mut Forcing) {
+        let v = self.velocity_at(t);
+        g.force(
             Sys::Trans,
             Some(0),
-            &Rows::constant(self.body_force(&fr.qt)),
+            self.damping.component_mul(&(fr.qt * v)),
         );
     }
 }
