@@ -53,6 +53,8 @@ class Field:
         if ext:
             self.ext = (np.array(ext.get("force", [0.0] * 3), float), np.array(ext.get("moment", [0.0] * 3), float),
                         np.array(ext.get("point", [0.0] * 3), float), ext.get("frame", "body"))
+        wd = params.get("wind")
+        self.wind = dict(wd) if wd else None
         wv = params.get("waves")
         self.waves = dict(wv) if wv else None
         self.g = h["gravity"]
@@ -135,6 +137,20 @@ class Field:
                 s += a[k] * np.sqrt(np.abs(d)) * np.cos(theta[k])
                 mean += a[k] ** 2 * d
         return first, 2.0 * np.sign(mean) * s ** 2
+
+    def wind_loads(self, t, v, Q):
+        """Body-frame wind force and moment (docs/model.md 5.10), written again."""
+        wd = self.wind
+        u = wd["speed"] + sum(a * np.cos(w * t + p) for w, a, p in
+                              zip(wd.get("gust_frequencies", []), wd.get("gust_amplitudes", []), wd.get("gust_phases", [])))
+        d = np.radians(wd["direction"])
+        rel = Q.T @ (u * np.array([np.cos(d), np.sin(d), 0.0])) - v
+        gamma = np.arctan2(rel[1], rel[0])
+        ang = np.radians(np.array(wd["angles"], float))
+        c = [np.interp(gamma, ang, np.array(wd[k], float), period=2 * np.pi) for k in ("cx", "cy", "cn")]
+        q = 0.5 * wd["air_density"] * (rel[0] ** 2 + rel[1] ** 2)
+        return (np.array([q * wd["frontal_area"] * c[0], q * wd["lateral_area"] * c[1], 0.0]),
+                np.array([0.0, 0.0, q * wd["lateral_area"] * wd["length"] * c[2]]))
 
     def thrust(self, tau_t, tau_r):
         """The thrusters' delivered force and moment (body) for the demand (X, Y, N): weighted
@@ -219,6 +235,9 @@ class Field:
         if self.thr_units is not None and self.on:
             tau_t, tau_r = self.thrust(tau_t, tau_r)
         fe, me = self.external(Q)
+        if self.wind is not None:
+            fw, mw = self.wind_loads(t, v, Q)
+            fe, me = fe + fw, me + mw
         if self.waves is not None:
             first, dr = self.wave_loads(t, x, Q)
             psi = euler_zyx(Q)[2]

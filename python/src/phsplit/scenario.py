@@ -167,7 +167,9 @@ def resolve(path: str | os.PathLike[str]) -> str:
 
 def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
     """The vessel tables an ``[environment]`` table stands for: ``[environment.current]`` is the
-    ``[current]`` component; ``[environment.waves]`` is a sea state (``phsplit.sea``), realised
+    ``[current]`` component; ``[environment.wind]`` a wind (``phsplit.sea.Wind``: speed,
+    direction, gust spectrum, seed), realised into the ``[wind]`` component, whose windage and
+    coefficients come from the vessel file or from the same table; ``[environment.waves]`` is a sea state (``phsplit.sea``), realised
     into the ``[waves]`` component's components, with its transfer functions from a Capytaine
     dataset (``hydro = "file.nc"``, relative to the scenario; ``symmetric = true`` mirrors a
     port–starboard symmetric hull's directions) or from the vessel file's own ``[waves]`` keys."""
@@ -175,13 +177,13 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
 
     if not isinstance(env, Mapping):
         raise _core.ScenarioParseError(f"{path}: [environment] must be a table")
-    allowed = ("current", "waves")
+    allowed = ("current", "waves", "wind")
     for k, v in env.items():
         if k not in allowed:
             near = difflib.get_close_matches(k, allowed, n=1)
             hint = f"; did you mean {near[0]!r}?" if near else ""
             raise _core.ScenarioParseError(f"{path}: unknown table [environment.{k}]{hint} (allowed: "
-                                           f"{', '.join(allowed)}; wind is not modelled yet)")
+                                           f"{', '.join(allowed)})")
         if not isinstance(v, Mapping):
             raise _core.ScenarioParseError(f"{path}: [environment.{k}] must be a table")
     out: dict[str, Any] = {}
@@ -206,6 +208,12 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
         out["waves"] = {**table, **comps}
+    if "wind" in env:
+        try:
+            realised, rest = sea.wind(dict(env["wind"]))
+        except (_core.ScenarioParseError, _core.InvalidInputError) as e:
+            raise type(e)(f"{path}: {e}") from None
+        out["wind"] = {**rest, **realised}
     return out
 
 

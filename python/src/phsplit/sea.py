@@ -147,3 +147,112 @@ def sea_state(table: dict) -> SeaState:
     if "omega_range" in kw:
         kw["omega_range"] = tuple(kw["omega_range"])
     return SeaState(**kw)
+
+
+# ----------------------------------------------------------------------------------------------
+# wind
+
+WIND_SPECTRA = ("harris", "npd")
+
+
+def harris(f, speed: float, drag: float = 0.002, length: float = 1800.0):
+    """The Harris gust spectrum (m² s⁻² per Hz) at frequencies ``f`` (Hz) for the mean speed
+    ``speed`` at 10 m: ``S(f) = 4 κ L U / (2 + (f L / U)²)^(5/6)`` with the surface drag
+    coefficient ``κ`` and the length scale ``L = 1800 m`` (R. I. Harris, "The nature of the
+    wind", 1971). ``κ = 0.002`` is the default of SINTEF's SIMA/SIMO for this spectrum
+    (values from 0.002 to 0.0026 are in use); its variance is ``6.6775 κ U²`` whatever ``L``.
+    (DNV-RP-C205 gives a σ-normalised variant of it; this is the κ form.)"""
+    f = np.asarray(f, dtype=float)
+    return 4.0 * drag * length * speed / (2.0 + (f * length / speed) ** 2) ** (5.0 / 6.0)
+
+
+def npd(f, speed: float, height: float = 10.0):
+    """The NPD (Frøya) gust spectrum (m² s⁻² per Hz) at frequencies ``f`` (Hz) for the 1-hour
+    mean speed ``speed`` at 10 m, at the height ``height`` (m):
+    ``S(f) = 320 (U/10)² (z/10)^0.45 / (1 + f̃ⁿ)^(5/(3n))``, ``f̃ = 172 f (z/10)^(2/3) (U/10)^(−0.75)``,
+    ``n = 0.468`` (the Frøya model of Andersen & Løvseth; API 2MET / ISO 19901-1:2005, A.7.4;
+    DNV-RP-C205, §2.3; as implemented in OpenFAST TurbSim's ``Spec_API``). Its variance is
+    ``(A/c)(1/n) B(1/n, 2/(3n))`` with ``A = 320 (U/10)² (z/10)^0.45``, ``c`` the factor of ``f``
+    in ``f̃``."""
+    f = np.asarray(f, dtype=float)
+    n = 0.468
+    ft = 172.0 * f * (height / 10.0) ** (2.0 / 3.0) * (speed / 10.0) ** -0.75
+    return 320.0 * (speed / 10.0) ** 2 * (height / 10.0) ** 0.45 / (1.0 + ft ** n) ** (5.0 / (3.0 * n))
+
+
+@dataclass(frozen=True)
+class Wind:
+    """A wind: mean ``speed`` (m/s at 10 m), ``direction`` (degrees, towards), and gusts from
+    the ``spectrum`` (``"harris"``, ``"npd"`` or None for a steady wind), realised with ``seed``
+    into ``components`` over ``omega_range`` (rad/s; default 0.001-0.5 rad/s, the slowly-varying
+    band a DP vessel responds to)."""
+
+    speed: float
+    direction: float = 0.0
+    spectrum: str | None = "npd"
+    seed: int = 0
+    components: int = 100
+    omega_range: tuple[float, float] = (0.001, 0.5)
+    height: float = 10.0
+    drag: float = 0.002
+
+    def __post_init__(self):
+        def bad(msg):
+            raise _core.InvalidInputError(f"wind: {msg}")
+
+        if not (isinstance(self.speed, (int, float)) and math.isfinite(self.speed) and 0 <= self.speed <= 80):
+            bad(f"speed must be a number in [0, 80] (m/s), got {self.speed!r}")
+        if self.spectrum is not None and self.spectrum not in WIND_SPECTRA:
+            bad(f"spectrum must be one of {', '.join(repr(s) for s in WIND_SPECTRA)} or absent, got {self.spectrum!r}")
+        if not (isinstance(self.components, int) and 1 <= self.components <= 10_000):
+            bad(f"components must be an integer in [1, 10000], got {self.components!r}")
+        if not (isinstance(self.seed, int) and self.seed >= 0):
+            bad(f"seed must be an integer >= 0, got {self.seed!r}")
+        lo, hi = self.omega_range
+        if not (0 < lo < hi and math.isfinite(hi)):
+            bad(f"omega_range must be two increasing frequencies > 0 (rad/s), got {self.omega_range!r}")
+        if not (math.isfinite(self.height) and self.height > 0):
+            bad(f"height must be > 0 (m), got {self.height!r}")
+
+    def density(self, omega) -> np.ndarray:
+        """The gust spectrum per rad/s at ``omega`` (rad/s)."""
+        f = np.asarray(omega, dtype=float) / (2 * np.pi)
+        if self.spectrum == "harris":
+            s = harris(f, self.speed, self.drag)
+        else:
+            s = npd(f, self.speed, self.height)
+        return s / (2 * np.pi)
+
+    def realise(self) -> dict:
+        """The ``[wind]`` table's wind keys: speed, direction and the gust components. The gust
+        spectra span decades and peak at the lowest frequencies, so the bins are equal in
+        ``log ω`` (each component at a random frequency inside its bin, its amplitude
+        ``√(2 S(ω_k) Δω_k)`` from the bin's width)."""
+        out = {"speed": float(self.speed), "direction": float(self.direction)}
+        if self.spectrum is None or self.speed == 0:
+            return out
+        rng = np.random.default_rng(self.seed)
+        lo, hi = self.omega_range
+        n = self.components
+        edges = np.geomspace(lo, hi, n + 1)
+        dw = np.diff(edges)
+        omega = edges[:-1] + rng.uniform(0.0, 1.0, n) * dw
+        amp = np.sqrt(2.0 * self.density(omega) * dw)
+        phase = rng.uniform(0.0, 2 * np.pi, n)
+        out.update(gust_frequencies=omega.tolist(), gust_amplitudes=amp.tolist(), gust_phases=phase.tolist())
+        return out
+
+
+def wind(table: dict) -> tuple[dict, dict]:
+    """A scenario's ``[environment.wind]``: the realised wind keys, and the rest (the windage
+    and coefficients), which go to the vessel's ``[wind]`` table unchanged."""
+    own = {"speed", "direction", "spectrum", "seed", "components", "omega_range", "height", "drag"}
+    if "speed" not in table:
+        raise _core.ScenarioParseError("missing field 'speed' in [environment.wind] (mean wind speed at 10 m, m/s)")
+    kw = {k: table[k] for k in own if k in table}
+    if "omega_range" in kw:
+        kw["omega_range"] = tuple(kw["omega_range"])
+    if kw.get("spectrum") == "none":
+        kw["spectrum"] = None
+    rest = {k: v for k, v in table.items() if k not in own}
+    return Wind(**kw).realise(), rest

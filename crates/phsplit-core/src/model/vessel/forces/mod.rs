@@ -45,6 +45,7 @@ pub mod pipe;
 pub mod restoring;
 pub mod thrusters;
 pub mod waves;
+pub mod wind;
 
 /// A component's builder: reads its keys, validates them, and returns the component, or `None`
 /// when the file does not ask for it (an optional component whose table is absent).
@@ -60,6 +61,7 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("current", &["current"], current::build),
     ("pipe", &["pipe"], pipe::build),
     ("waves", &["waves"], waves::build),
+    ("wind", &["wind"], wind::build),
 ];
 
 /// The two block systems of flow S2 (paper eq. 41):

@@ -1,0 +1,284 @@
+//! Wind as a port: mean wind and gusts acting through load coefficient tables
+//! (docs/model.md §5.10).
+//!
+//! Table `[wind]` (optional):
+//! - `speed` (m/s, ≥ 0): the mean wind speed at the reference height of the coefficients;
+//!   `direction` (degrees, spatial, from x towards y): the direction the wind blows towards;
+//! - gusts (optional; realised from a gust spectrum by `phsplit.sea.Wind`): `gust_frequencies`
+//!   (rad/s, > 0), `gust_amplitudes` (m/s, ≥ 0), `gust_phases` (rad), one entry per component,
+//!   so that the wind speed is `U(t) = speed + Σ a_k cos(ω_k t + φ_k)` along `direction`
+//!   (longitudinal turbulence, uniform over the hull);
+//! - the hull's windage: `frontal_area` A_F and `lateral_area` A_L (m², > 0), `length` L (m,
+//!   > 0), `air_density` ρ_a (kg/m³, > 0);
+//! - the load coefficients on a grid of relative wind angles: `angles` (degrees, increasing,
+//!   spanning less than 360; interpolated linearly and periodically) and `cx`, `cy`, `cn`, one
+//!   value per angle (user-given, or from Isherwood's or Blendermann's regressions).
+//!
+//! With `w = Qᵀ W(t) − v` the air's velocity relative to the hull in the body frame (`W` the
+//! wind velocity, `v` the vessel's), its horizontal speed `V_r = |(w_x, w_y)|` and its angle
+//! `γ = atan2(w_y, w_x)` (0: the air flows from stern to bow, 180: a head wind), the loads are
+//! (T. I. Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2nd ed., 2021,
+//! §10.1, with its angle convention replaced by this one):
+//!
+//! `X = q A_F C_X(γ)`, `Y = q A_L C_Y(γ)`, `N = q A_L L C_N(γ)`, `q = ½ ρ_a V_r²`,
+//!
+//! a body-frame force `(X, Y, 0)` and yaw moment `N` about the body origin. They depend on time
+//! and on the vessel's velocity, so they are a forcing of flow S2 (Gauss collocation at the
+//! stages, docs/model.md §3.7). Ledger: the port `wind` (supplied; the velocity-dependent part
+//! is the aerodynamic damping, which it books too).
+
+use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
+use crate::error::Error;
+use crate::flows::collocation::Z3;
+use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::state::VesselState;
+use crate::solve::{Account, AccountKind};
+use nalgebra::Vector3;
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Wind {
+    pub speed: f64,
+    /// Radians, spatial.
+    pub direction: f64,
+    /// `(ω_k, a_k, φ_k)`.
+    pub gusts: Vec<(f64, f64, f64)>,
+    pub frontal_area: f64,
+    pub lateral_area: f64,
+    pub length: f64,
+    pub air_density: f64,
+    /// Radians, increasing, spanning less than 2π.
+    pub angles: Vec<f64>,
+    /// `(C_X, C_Y, C_N)` per angle.
+    pub coefficients: Vec<[f64; 3]>,
+    /// The vessel's mass, for `v = p / m`.
+    pub mass: f64,
+}
+
+fn list(
+    p: &mut Params,
+    key: &str,
+    unit: &str,
+    range: Range,
+    required: bool,
+) -> crate::Result<Vec<f64>> {
+    match p.rows("wind", key, 1, unit, range)? {
+        Some(r) => Ok(r.into_iter().map(|x| x[0]).collect()),
+        None if required => Err(Error::Parse(format!(
+            "missing field `{key}` in [wind] ({unit})"
+        ))),
+        None => Ok(Vec::new()),
+    }
+}
+
+pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+    const T: &str = "wind";
+    p.declare(T);
+    if !p.has(T) {
+        return Ok(None);
+    }
+    let speed = p.f64(T, "speed", "m/s", Range::NonNegative)?;
+    if speed > 80.0 {
+        return Err(Error::InvalidInput(format!(
+            "wind.speed must be at most 80 m/s (beyond any recorded 10-minute mean at sea), got {speed}"
+        )));
+    }
+    let direction = p
+        .f64(T, "direction", "degrees", Range::Finite)?
+        .to_radians();
+    let frontal_area = p.f64(T, "frontal_area", "m^2", Range::Positive)?;
+    let lateral_area = p.f64(T, "lateral_area", "m^2", Range::Positive)?;
+    let length = p.f64(T, "length", "m", Range::Positive)?;
+    let air_density = p.f64(T, "air_density", "kg/m^3", Range::Positive)?;
+    let gf = list(p, "gust_frequencies", "rad/s", Range::Positive, false)?;
+    let ga = list(p, "gust_amplitudes", "m/s", Range::NonNegative, false)?;
+    let gp = list(p, "gust_phases", "rad", Range::Finite, false)?;
+    if ga.len() != gf.len() || gp.len() != gf.len() {
+        return Err(Error::InvalidInput(format!(
+            "wind.gust_frequencies, gust_amplitudes and gust_phases must have one entry per component: got {}, {}, {}",
+            gf.len(),
+            ga.len(),
+            gp.len()
+        )));
+    }
+    let angles = list(p, "angles", "degrees", Range::Finite, true)?;
+    let cx = list(p, "cx", "dimensionless", Range::Finite, true)?;
+    let cy = list(p, "cy", "dimensionless", Range::Finite, true)?;
+    let cn = list(p, "cn", "dimensionless", Range::Finite, true)?;
+    if angles.is_empty()
+        || cx.len() != angles.len()
+        || cy.len() != angles.len()
+        || cn.len() != angles.len()
+    {
+        return Err(Error::InvalidInput(format!(
+            "wind.angles, cx, cy and cn must have one value per angle, and at least one: got {}, {}, {}, {}",
+            angles.len(),
+            cx.len(),
+            cy.len(),
+            cn.len()
+        )));
+    }
+    if let Some(i) = (1..angles.len()).find(|&i| angles[i] <= angles[i - 1]) {
+        return Err(Error::InvalidInput(format!(
+            "wind.angles must increase strictly (degrees): angles[{i}] = {} after {}",
+            angles[i],
+            angles[i - 1]
+        )));
+    }
+    if angles[angles.len() - 1] - angles[0] >= 360.0 {
+        return Err(Error::InvalidInput(format!(
+            "wind.angles must span less than 360 degrees (the table is periodic), got {} to {}",
+            angles[0],
+            angles[angles.len() - 1]
+        )));
+    }
+    Ok(Some(Arc::new(Wind {
+        speed,
+        direction,
+        gusts: (0..gf.len()).map(|k| (gf[k], ga[k], gp[k])).collect(),
+        frontal_area,
+        lateral_area,
+        length,
+        air_density,
+        angles: angles.iter().map(|a| a.to_radians()).collect(),
+        coefficients: (0..cx.len()).map(|k| [cx[k], cy[k], cn[k]]).collect(),
+        mass: body.mass,
+    })))
+}
+
+const ACCOUNTS: [Account; 1] = [Account {
+    name: "wind",
+    kind: AccountKind::Supplied,
+}];
+
+impl Wind {
+    /// The wind speed at time `t` (m/s).
+    pub fn speed_at(&self, t: f64) -> f64 {
+        self.speed
+            + self
+                .gusts
+                .iter()
+                .map(|(w, a, ph)| a * (w * t + ph).cos())
+                .sum::<f64>()
+    }
+
+    /// The coefficients at the relative angle `gamma` (rad), periodic linear interpolation.
+    pub fn coefficients_at(&self, gamma: f64) -> [f64; 3] {
+        let a = &self.angles;
+        let n = a.len();
+        if n == 1 {
+            return self.coefficients[0];
+        }
+        let b = a[0] + (gamma - a[0]).rem_euclid(TAU);
+        let i = a.partition_point(|x| *x <= b);
+        let (i0, i1, w) = if i == 0 || i == n {
+            let bb = if b < a[n - 1] { b + TAU } else { b };
+            (n - 1, 0, (bb - a[n - 1]) / (a[0] + TAU - a[n - 1]))
+        } else {
+            (i - 1, i, (b - a[i - 1]) / (a[i] - a[i - 1]))
+        };
+        let (c0, c1) = (self.coefficients[i0], self.coefficients[i1]);
+        std::array::from_fn(|k| c0[k] * (1.0 - w) + c1[k] * w)
+    }
+
+    /// The body-frame force and moment at attitude `Qᵀ = qt`, body velocity `v` and time `t`.
+    pub fn loads(
+        &self,
+        qt: &nalgebra::Matrix3<f64>,
+        v: &Vector3<f64>,
+        t: f64,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let u = self.speed_at(t);
+        let wind = Vector3::new(u * self.direction.cos(), u * self.direction.sin(), 0.0);
+        let rel = qt * wind - v;
+        let vr2 = rel.x * rel.x + rel.y * rel.y;
+        if vr2 == 0.0 {
+            return (Vector3::zeros(), Vector3::zeros());
+        }
+        let c = self.coefficients_at(rel.y.atan2(rel.x));
+        let q = 0.5 * self.air_density * vr2;
+        (
+            Vector3::new(
+                q * self.frontal_area * c[0],
+                q * self.lateral_area * c[1],
+                0.0,
+            ),
+            Vector3::new(0.0, 0.0, q * self.lateral_area * self.length * c[2]),
+        )
+    }
+}
+
+impl Force for Wind {
+    fn name(&self) -> &'static str {
+        "wind"
+    }
+    fn accounts(&self) -> &'static [Account] {
+        &ACCOUNTS
+    }
+    /// All of the wind's loads are forcing (time and velocity dependent).
+    fn add_s2(&self, _fr: &Frozen, _b: &mut S2Builder) {}
+    fn forced(&self) -> bool {
+        true
+    }
+    fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
+        let (f, m) = self.loads(&fr.qt, &(z[0][0] / self.mass), t);
+        g.force(Sys::Trans, Some(0), f);
+        g.force(Sys::Rot, Some(0), m);
+    }
+    fn outputs(&self, _fr: &Frozen, _z: &[Z3; 2], _s: &VesselState, t: f64, out: &mut Vec<Output>) {
+        out.push(Output::new(
+            "wind_speed",
+            "m s-1",
+            "wind speed (mean and gusts)",
+            self.speed_at(t),
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_head_wind_on_a_table_gives_the_stated_loads() {
+        let w = Wind {
+            speed: 20.0,
+            direction: std::f64::consts::PI, // blowing towards −x
+            gusts: vec![],
+            frontal_area: 300.0,
+            lateral_area: 900.0,
+            length: 80.0,
+            air_density: 1.2,
+            angles: vec![
+                0.0,
+                std::f64::consts::FRAC_PI_2,
+                std::f64::consts::PI,
+                1.5 * std::f64::consts::PI,
+            ],
+            coefficients: vec![
+                [0.6, 0.0, 0.0],
+                [0.0, 0.9, 0.05],
+                [-0.7, 0.0, 0.0],
+                [0.0, -0.9, -0.05],
+            ],
+            mass: 1.0,
+        };
+        // vessel at rest, heading x: the air flows from bow to stern, γ = 180°.
+        let (f, m) = w.loads(&nalgebra::Matrix3::identity(), &Vector3::zeros(), 0.0);
+        let q = 0.5 * 1.2 * 400.0;
+        assert!((f.x - q * 300.0 * -0.7).abs() < 1e-9 && f.y.abs() < 1e-9 && m.z.abs() < 1e-9);
+        // moving at 5 m/s into it: V_r = 25 m/s
+        let (f, _) = w.loads(
+            &nalgebra::Matrix3::identity(),
+            &Vector3::new(5.0, 0.0, 0.0),
+            0.0,
+        );
+        assert!((f.x - 0.5 * 1.2 * 625.0 * 300.0 * -0.7).abs() < 1e-9);
+        // between the table's angles, periodic: γ = 225° is halfway between 180° and 270°
+        let c = w.coefficients_at(1.25 * std::f64::consts::PI);
+        assert!((c[0] + 0.35).abs() < 1e-12 && (c[1] + 0.45).abs() < 1e-12);
+        let c = w.coefficients_at(-0.25 * std::f64::consts::PI);
+        assert!((c[0] - 0.3).abs() < 1e-12 && (c[1] + 0.45).abs() < 1e-12);
+    }
+}
