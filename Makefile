@@ -48,6 +48,7 @@ bench: $(VENV)/.built $(VENV)/.bench-deps
 	cargo bench -p phsplit-core --bench flows
 	$(BIN)/python benchmarks/work_precision.py
 	$(BIN)/python benchmarks/sweep_throughput.py
+	$(BIN)/python benchmarks/weather_stability.py
 
 bench-quick: $(VENV)/.built $(VENV)/.bench-deps
 	$(BIN)/python benchmarks/work_precision.py --quick --out benchmarks/results-quick

@@ -243,6 +243,9 @@ CATALOGUE: list[Bad] = [
         ("[environment.weather]", "allowed: current, waves, wind")),
     Bad("wind without its windage", scenario("[environment.wind]\nspeed = 15.0\ndirection = 0.0\n"), P,
         ("missing field `frontal_area` in [wind]",)),
+    Bad("wind coefficients for an unknown ship type",
+        scenario('[environment.wind]\nspeed = 15.0\nship_type = "yacht"\nfrontal_area = 10.0\nlateral_area = 30.0\n'
+                 'length = 20.0\nair_density = 1.225\n'), E, ("unknown ship type 'yacht'", "offshore supply vessel")),
     Bad("wind with an unknown gust spectrum",
         scenario('[environment.wind]\nspeed = 15.0\nspectrum = "kaimal"\n'), E, ("spectrum must be one of", "npd")),
     Bad("sea state without a peak period", scenario("[environment.waves]\nhs = 2.0\n"), P,

@@ -219,3 +219,47 @@ def test_bad_waves_tables_are_named(change, words):
 def test_bad_sea_states_are_named(kw, words):
     with pytest.raises(phsplit.InvalidInputError, match=words):
         sea.SeaState(**{"hs": 2.0, "tp": 8.0, **kw})
+
+
+def test_the_shipped_dp_weather_scenario_runs_reruns_and_is_cf_compliant(tmp_path, capsys):
+    from phsplit.cli import main
+    from test_results import cf_problems
+
+    assert "dp-weather" in phsplit.scenario.shipped()
+    sc = phsplit.load_scenario("dp-weather")
+    assert sc.vessel.components[-3:] == ["current", "waves", "wind"]
+    assert main(["simulate", "dp-weather", "--t-end", "60", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    for src in ("current supplied", "waves supplied", "wind supplied"):
+        assert src in out
+    nc = tmp_path / "dp-weather-t60.nc"
+    assert nc.exists() and (tmp_path / "dp-weather-t60.png").exists()
+    ds = phsplit.open_dataset(str(nc))
+    for name in ("force_waves", "force_wind", "force_current", "wave_elevation", "wind_speed"):
+        assert name in ds, name
+    assert cf_problems(nc) == []
+    assert phsplit.results.compare(ds, phsplit.rerun(ds)) == []
+    # the scenario's wind coefficients are Blendermann's for an offshore supply vessel
+    w = sc.vessel.to_dict()["wind"]
+    ref_coef = sea.blendermann("offshore supply vessel", 182.0, 533.0, 76.2)
+    assert w["cx"] == ref_coef["cx"] and w["angles"] == ref_coef["angles"]
+
+
+def test_blendermann_coefficients_follow_the_published_formula():
+    """Offshore supply vessel (CD_t 0.90, CD_l,AF 0.55 bow / 0.80 stern, delta 0.55): a head wind
+    (air flowing aft, phsplit's 180 degrees) gives C_X = -0.55; a wind from astern +0.80; a beam
+    wind C_Y = CD_t towards the flow; in between, the formula with its denominator, written again."""
+    t = sea.blendermann("offshore supply vessel", 182.0, 533.0, 76.2, step=15.0)
+    at = {a: (cx, cy, cn) for a, cx, cy, cn in zip(t["angles"], t["cx"], t["cy"], t["cn"])}
+    assert at[180.0][0] == pytest.approx(-0.55) and at[0.0][0] == pytest.approx(0.80)
+    assert at[90.0][1] == pytest.approx(0.90) and at[270.0][1] == pytest.approx(-0.90)
+    g = math.radians(135.0) + math.pi  # phsplit's 135 degrees is Fossen's angle of attack 315 = -45 degrees
+    gr = math.atan2(math.sin(g), math.cos(g))
+    cdl = 0.55 * 182.0 / 533.0
+    den = 1 - 0.5 * 0.55 * (1 - cdl / 0.90) * math.sin(2 * gr) ** 2
+    assert at[135.0][0] == pytest.approx(-0.55 * math.cos(gr) / den)
+    assert at[135.0][1] == pytest.approx(-0.90 * math.sin(gr) / den)
+    # the yaw moment is antisymmetric: a wind from the other bow turns the other way
+    assert at[135.0][2] == pytest.approx(-at[225.0][2])
+    with pytest.raises(phsplit.InvalidInputError, match="unknown ship type 'yacht'"):
+        sea.blendermann("yacht", 1.0, 1.0, 1.0)

@@ -11,6 +11,7 @@ EXAMPLES = """examples:
   phsplit simulate                         # the paper's Fig. 2 scenario (SP4, h = 0.5, [0, 200])
   phsplit simulate scenario.toml --out runs/
   phsplit simulate pipelay                 # a shipped scenario: pipe-lay along a route, thrusters, 1 h
+  phsplit simulate dp-weather              # a shipped scenario: station keeping in waves, wind, current, 1 h
   phsplit simulate --method sp2 --h 0.25 --t-end 400
   phsplit simulate --control-start never   # the controller off throughout
   phsplit methods                          # methods with order, stages and passivity guarantee
@@ -50,7 +51,7 @@ def _parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     s.add_argument("scenario", nargs="?", help="scenario TOML file, or the name of a shipped scenario "
-                   "(pipelay; default: the paper's Fig. 2)")
+                   "(pipelay, dp-weather; default: the paper's Fig. 2)")
     s.add_argument("--out", default="out", help="output folder (default: ./out)")
     s.add_argument("--method", help="override the method")
     s.add_argument("--h", type=float, help="override the step size, s")

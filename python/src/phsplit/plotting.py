@@ -101,7 +101,8 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     moving = "setpoint_x" in ds
     piped = "pipe_top_tension" in ds
     thrust = "thrust_utilisation" in ds
-    rows = 4 if (piped or thrust) else 3
+    env = [a for a in ("current", "wind", "waves", "wave_drift", "external") if f"force_{a}" in ds]
+    rows = 4 if (piped or thrust or env) else 3
     fig = plt.figure(figsize=(15, 3 * rows), layout="constrained")
     gs = fig.add_gridspec(rows, 3)
     ax_track = fig.add_subplot(gs[:, 0])
@@ -174,7 +175,16 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     ax_en.legend(fontsize=7)
     if rows == 4:
         ax_pipe, ax_thr = axes[6:8]
-        if piped:
+        if env and not piped:
+            # the environment's horizontal force on the hull, by source (spatial frame)
+            Q = np.asarray(ds["attitude"].values) if "attitude" in ds else None
+            for a in env:
+                fb = np.asarray(ds[f"force_{a}"].values)
+                fs = np.einsum("nij,nj->ni", Q, fb) if Q is not None else fb
+                ax_pipe.plot(t, np.hypot(fs[:, 0], fs[:, 1]) / 1e3, lw=0.9, label=a)
+            ax_pipe.set_ylabel("horizontal force by source [kN]")
+            ax_pipe.legend(fontsize=7, loc="upper right")
+        elif piped:
             ax_pipe.plot(t, ds["pipe_top_tension"].values / 1e3, lw=1.2, label="top tension [kN]")
             ax_pipe.plot(t, ds["pipe_horizontal_tension"].values / 1e3, lw=1.0, label="horizontal tension [kN]")
             ax_pipe.set_ylabel("pipe tension [kN]")
@@ -195,6 +205,13 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
             ax4.plot(t, ds["thrust_utilisation"].values, "k:", lw=1.0)
             ax4.set_ylabel("utilisation (dotted)")
             ax4.set_ylim(0, 1.05)
+        elif env and "wave_elevation" in ds:
+            ax_thr.plot(t, ds["wave_elevation"].values, lw=0.7, color="C0", label="wave elevation [m]")
+            ax_thr.set_ylabel("wave elevation [m]")
+            if "wind_speed" in ds:
+                ax5 = ax_thr.twinx()
+                ax5.plot(t, ds["wind_speed"].values, lw=0.9, color="C3")
+                ax5.set_ylabel("wind speed [m/s]", color="C3")
         else:
             ax_thr.set_axis_off()
     for ax in axes:

@@ -367,8 +367,13 @@ impl Force for Waves {
     fn name(&self) -> &'static str {
         "waves"
     }
+    /// `waves`, and `wave_drift` when there are drift coefficients.
     fn accounts(&self) -> &'static [Account] {
-        &ACCOUNTS
+        if self.drift.is_some() {
+            &ACCOUNTS
+        } else {
+            &ACCOUNTS[..1]
+        }
     }
     /// All of the waves' loads are forcing (time and position dependent).
     fn add_s2(&self, _fr: &Frozen, _b: &mut S2Builder) {}
