@@ -136,9 +136,9 @@ def test_sp2_stays_within_its_passivity_bound_for_an_hour_at_h_1():
 # -- Capytaine --------------------------------------------------------------------------------
 
 def test_the_capytaine_loader_reproduces_capytaines_values():
-    """The stored dataset (scripts/gen_capytaine_box.py, Capytaine 3.0.0): the loader's added mass
-    and excitation force equal Capytaine's, read here with xarray, exactly (the force as the
-    complex conjugate: e^{-iwt} to e^{+iwt})."""
+    """The stored dataset (scripts/gen_capytaine_box.py, Capytaine 3.0.0): the loader's added mass,
+    excitation force and drift coefficients equal Capytaine's, read here with xarray, exactly (the
+    force as the complex conjugate: e^{-iwt} to e^{+iwt})."""
     raw = xr.open_dataset(DATA)
     out = hydro.from_capytaine(DATA)
     i = int(np.argmax(raw["omega"].values))
@@ -155,11 +155,26 @@ def test_the_capytaine_loader_reproduces_capytaines_values():
                 im = float(exc.sel(complex="im", omega=w, wave_direction=beta, influenced_dof=dof))
                 assert out["waves"]["force_rao_real"][k][j][n] == re
                 assert out["waves"]["force_rao_imag"][k][j][n] == -im
+    # the mean drift (phsplit's drift_force variable, from Capytaine's far field), exactly
+    drift = raw["drift_force"]
+    for di, beta in enumerate(raw["wave_direction"].values):
+        k = out["waves"]["rao_directions"].index(float(np.degrees(beta)))
+        for fi, w in enumerate(raw["omega"].values):
+            j = out["waves"]["rao_frequencies"].index(float(w))
+            want = [float(drift.sel(omega=w, wave_direction=beta, drift_dof=n)) for n in ("Surge", "Sway", "Yaw")]
+            assert out["waves"]["drift_coefficients"][k][j] == want
+    # and it is physical: along the waves in head and following seas, growing towards the wall
+    # limit rho g B / 2 of an 8 m wide box (4.0e4 N/m^2) in short head waves
+    surge = drift.sel(drift_dof="Surge")
+    assert float(surge.isel(omega=-1).sel(wave_direction=0.0)) > 0 > float(surge.isel(omega=-1).sel(wave_direction=np.pi))
+    assert 0.5 < float(surge.isel(omega=-1).sel(wave_direction=0.0)) / (0.5 * 1025 * 9.81 * 8.0) < 1.5
     # mirrored for a symmetric hull: 270 degrees is 90 with sway, roll and yaw reversed
     sym = hydro.from_capytaine(DATA, symmetric=True)["waves"]
     a, b = sym["rao_directions"].index(90.0), sym["rao_directions"].index(270.0)
     np.testing.assert_array_equal(np.array(sym["force_rao_real"][b]),
                                   np.array(sym["force_rao_real"][a]) * np.array([1, -1, 1, -1, 1, -1]))
+    np.testing.assert_array_equal(np.array(sym["drift_coefficients"][b]),
+                                  np.array(sym["drift_coefficients"][a]) * np.array([1, -1, -1]))
     # and the vessel takes the tables
     d = phsplit.Vessel.paper().to_dict()
     d["waves"] = {**sym, **sea.regular(0.5, 1.0, direction=180.0)}
@@ -230,7 +245,7 @@ def test_the_shipped_dp_weather_scenario_runs_reruns_and_is_cf_compliant(tmp_pat
     assert sc.vessel.components[-3:] == ["current", "waves", "wind"]
     assert main(["simulate", "dp-weather", "--t-end", "60", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    for src in ("current supplied", "waves supplied", "wind supplied"):
+    for src in ("current supplied", "waves supplied", "wave_drift supplied", "wind supplied"):
         assert src in out
     nc = tmp_path / "dp-weather-t60.nc"
     assert nc.exists() and (tmp_path / "dp-weather-t60.png").exists()

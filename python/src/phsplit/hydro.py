@@ -12,9 +12,15 @@ that file written with ``capytaine.io.xarray.separate_complex_values`` and reope
   amplitude. Capytaine writes amplitudes for the time dependence ``e^{−iωt}``, phsplit for
   ``e^{+iωt}``: the loader takes the complex conjugate, which describes the same real force.
 
-Capytaine 3 does not give drift coefficients without Kochin functions and motions; give them in
-``[waves] drift_coefficients`` yourself. The added mass needs a general mass matrix, which the
-paper's vessel model does not have yet (issue 18): it is returned, not applied."""
+* ``drift_coefficients`` (``[direction][frequency][3]``: surge, sway, yaw), when the dataset has
+  the variable ``drift_force`` (``omega``, ``wave_direction``, ``drift_dof``) that
+  ``scripts/gen_capytaine_box.py`` adds from Capytaine's far-field mean drift
+  (``capytaine.post_pro.mean_drift_force.far_field_mean_drift_force`` on the free-floating
+  motions; it needs Kochin functions, i.e. a ``theta`` coordinate in the test matrix). It is
+  real (a mean force): no conjugation.
+
+The added mass needs a general mass matrix, which the paper's vessel model does not have yet
+(issue 18): it is returned, not applied."""
 from __future__ import annotations
 
 import numpy as np
@@ -74,8 +80,18 @@ def from_capytaine(ds, omega: float | None = None, symmetric: bool = False) -> d
         f = np.concatenate([f, np.array([x for _, x in extra]).reshape(-1, *f.shape[1:])])
     d_order = np.argsort(dirs)
     dirs, f = dirs[d_order], f[d_order]
-    return {
-        "added_mass": added,
-        "waves": {"rao_frequencies": w.tolist(), "rao_directions": dirs.tolist(),
-                  "force_rao_real": f.real.tolist(), "force_rao_imag": f.imag.tolist()},
-    }
+    waves = {"rao_frequencies": w.tolist(), "rao_directions": dirs.tolist(),
+             "force_rao_real": f.real.tolist(), "force_rao_imag": f.imag.tolist()}
+    if "drift_force" in ds.variables:
+        dv = ds["drift_force"]
+        if set(dv.dims) != {"omega", "wave_direction", "drift_dof"}:
+            raise _core.InvalidInputError(f"the dataset's drift_force must have the dimensions omega, wave_direction "
+                                          f"and drift_dof, got {dv.dims}")
+        dr = np.asarray(dv.sel(drift_dof=["Surge", "Sway", "Yaw"]).transpose("wave_direction", "omega", "drift_dof")
+                        .values, dtype=float)[:, order, :]
+        if symmetric:
+            base = np.degrees(np.asarray(ds["wave_direction"].values, dtype=float))
+            extra = [dr[i] * np.array([1, -1, -1]) for i, d in enumerate(base) if 0.0 < d < 180.0]
+            dr = np.concatenate([dr, np.array(extra).reshape(-1, *dr.shape[1:])])
+        waves["drift_coefficients"] = dr[d_order].tolist()
+    return {"added_mass": added, "waves": waves}
