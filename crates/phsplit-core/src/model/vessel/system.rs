@@ -135,10 +135,16 @@ impl<'a> VesselSystem<'a> {
     /// The forcing of flow S2 at time `t` and block states `z` (zero without forced
     /// components).
     fn forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2]) -> Forcing {
+        self.forcing_of(fr, t, z, None)
+    }
+
+    /// The forcing of the components whose forcing uses the state (`Some(true)`), does not
+    /// (`Some(false)`), or of all (`None`).
+    fn forcing_of(&self, fr: &Frozen, t: f64, z: &[Z3; 2], uses_state: Option<bool>) -> Forcing {
         let mut g = Forcing::new();
         if self.forced {
             for (f, base) in self.vessel.forces.iter().zip(&self.bases) {
-                if f.forced() {
+                if f.forced() && uses_state.is_none_or(|u| u == f.forcing_uses_state()) {
                     g.base = *base;
                     f.add_forcing(fr, t, z, &mut g);
                 }
@@ -491,10 +497,26 @@ impl<'a> VesselSystem<'a> {
         let mut stage_z = [*z0; 3];
         let mut ys = [[SVector::<f64, 10>::zeros(); 3]; 2];
         let mut g = [Forcing::new(); 3];
+        // The parts that depend on time only, once per stage; the rest per pass.
+        let fixed: [Forcing; 3] = std::array::from_fn(|i| {
+            if i < s {
+                self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(false))
+            } else {
+                Forcing::new()
+            }
+        });
+        let stateful = self
+            .vessel
+            .forces
+            .iter()
+            .any(|f| f.forced() && f.forcing_uses_state());
         let mut last_change = f64::INFINITY;
         for it in 0..FORCED_MAX_ITERATIONS {
             for i in 0..s {
-                g[i] = self.forcing(fr, t + nodes[i] * h, &stage_z[i]);
+                g[i] = fixed[i];
+                if stateful {
+                    g[i].add(&self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true)));
+                }
             }
             let mut change: f64 = 0.0;
             for k in 0..2 {
@@ -536,10 +558,17 @@ impl<'a> VesselSystem<'a> {
             if it + 1 == FORCED_MAX_ITERATIONS && change > 1e-10 {
                 return nan;
             }
+            // Without a state-dependent forcing the first pass is the solution.
+            if !stateful {
+                break;
+            }
             last_change = change;
         }
         for i in 0..s {
-            g[i] = self.forcing(fr, t + nodes[i] * h, &stage_z[i]);
+            g[i] = fixed[i];
+            if stateful {
+                g[i].add(&self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true)));
+            }
         }
         let mut z1 = [[Vector3::zeros(); 3]; 2];
         for k in 0..2 {

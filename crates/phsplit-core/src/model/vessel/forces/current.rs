@@ -169,6 +169,9 @@ impl Force for Current {
     fn forced(&self) -> bool {
         self.table.is_some()
     }
+    fn forcing_uses_state(&self) -> bool {
+        false
+    }
     fn add_forcing(&self, fr: &Frozen, t: f64, _z: &[Z3; 2], g: &mut Forcing) {
         let v = self.velocity_at(t);
         g.force(

@@ -201,6 +201,18 @@ impl Forcing {
     pub fn rate_w(&mut self, sys: Sys, r: Vector3<f64>) {
         self.g[sys as usize][2] += r;
     }
+    /// Add another forcing (of other components) to this one.
+    pub(crate) fn add(&mut self, o: &Forcing) {
+        for k in 0..2 {
+            for i in 0..3 {
+                self.g[k][i] += o.g[k][i];
+            }
+        }
+        for (a, b) in self.booked.iter_mut().zip(o.booked.iter()) {
+            a[0] += b[0];
+            a[1] += b[1];
+        }
+    }
 }
 
 /// A named scalar a component reports at a state, for the results (CF units).
@@ -243,6 +255,11 @@ pub trait Force: Debug + Send + Sync {
     /// Gauss collocation.
     fn forced(&self) -> bool {
         false
+    }
+    /// Whether its forcing depends on the block states (else only on time and the frozen
+    /// attitude: the collocation then evaluates it once per stage, not once per iteration).
+    fn forcing_uses_state(&self) -> bool {
+        true
     }
     /// Its forcing part at time `t` and block states `z` (translation `(p, x − x_o, phi_x)`,
     /// rotation `(m, mu, phi_th)`) at the frozen attitude: the part of its force that is not

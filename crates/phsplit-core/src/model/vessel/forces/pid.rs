@@ -310,6 +310,10 @@ impl Force for Pid {
     fn forced(&self) -> bool {
         self.setpoint.is_some() || self.thrusters.is_some()
     }
+    /// The moving set point's part depends on time only; the thrusters' on the demand.
+    fn forcing_uses_state(&self) -> bool {
+        self.thrusters.is_some()
+    }
     /// With a moving set point: the reference model's desired position and heading, and the
     /// vessel's horizontal distance from the desired position. With thrusters: the demand and
     /// what they deliver in surge, sway and yaw, each thruster's thrust and angle, and the

@@ -77,7 +77,62 @@ pub struct Table<const N: usize> {
     pub im: Vec<Vec<[f64; N]>>,
 }
 
+/// A table's values at one frequency, per direction: the frequency interpolation done once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AtFrequency<const N: usize> {
+    pub re: Vec<[f64; N]>,
+    pub im: Vec<[f64; N]>,
+}
+
 impl<const N: usize> Table<N> {
+    /// The values at `omega` for every direction of the grid (linear in frequency).
+    pub fn at_frequency(&self, omega: f64) -> AtFrequency<N> {
+        let mut re = Vec::with_capacity(self.directions.len());
+        let mut im = Vec::with_capacity(self.directions.len());
+        for i in 0..self.directions.len() {
+            // The grid's own interpolation, at the direction's node.
+            let (r, m) = self.at(omega, self.directions[i]);
+            re.push(r);
+            im.push(m);
+        }
+        AtFrequency { re, im }
+    }
+
+    /// Interpolate values precomputed at one frequency in the relative direction `beta`,
+    /// periodically, as [`Table::at`] does.
+    pub fn in_direction(&self, pre: &AtFrequency<N>, beta: f64) -> ([f64; N], [f64; N]) {
+        let (i0, i1, wd) = self.direction_weights(beta);
+        let mut re = [0.0; N];
+        let mut im = [0.0; N];
+        for n in 0..N {
+            re[n] = (1.0 - wd) * pre.re[i0][n] + wd * pre.re[i1][n];
+            im[n] = (1.0 - wd) * pre.im[i0][n] + wd * pre.im[i1][n];
+        }
+        (re, im)
+    }
+
+    /// The two directions around `beta` and the weight of the second.
+    fn direction_weights(&self, beta: f64) -> (usize, usize, f64) {
+        let d = &self.directions;
+        let nd = d.len();
+        if nd == 1 {
+            return (0, 0, 0.0);
+        }
+        let b = d[0] + (beta - d[0]).rem_euclid(TAU);
+        let i = d.partition_point(|x| *x <= b);
+        if i == 0 || i == nd {
+            let (lo, hi) = (d[nd - 1], d[0] + TAU);
+            let bb = if b < d[nd - 1] { b + TAU } else { b };
+            (nd - 1, 0, ((bb - lo) / (hi - lo)).clamp(0.0, 1.0))
+        } else {
+            (
+                i - 1,
+                i,
+                ((b - d[i - 1]) / (d[i] - d[i - 1])).clamp(0.0, 1.0),
+            )
+        }
+    }
+
     /// The interpolated (re, im) at `omega` (inside the frequency range) and relative
     /// direction `beta` (rad, any value).
     pub fn at(&self, omega: f64, beta: f64) -> ([f64; N], [f64; N]) {
@@ -91,26 +146,7 @@ impl<const N: usize> Table<N> {
         } else {
             ((omega - f[j0]) / (f[j1] - f[j0])).clamp(0.0, 1.0)
         };
-        let d = &self.directions;
-        let nd = d.len();
-        let (i0, i1, wd) = if nd == 1 {
-            (0, 0, 0.0)
-        } else {
-            // Wrap beta into [d0, d0 + 2π), then find its interval, the last one closing the circle.
-            let b = d[0] + (beta - d[0]).rem_euclid(TAU);
-            let i = d.partition_point(|x| *x <= b);
-            if i == 0 || i == nd {
-                let (lo, hi) = (d[nd - 1], d[0] + TAU);
-                let bb = if b < d[nd - 1] { b + TAU } else { b };
-                (nd - 1, 0, ((bb - lo) / (hi - lo)).clamp(0.0, 1.0))
-            } else {
-                (
-                    i - 1,
-                    i,
-                    ((b - d[i - 1]) / (d[i] - d[i - 1])).clamp(0.0, 1.0),
-                )
-            }
-        };
+        let (i0, i1, wd) = self.direction_weights(beta);
         let mut re = [0.0; N];
         let mut im = [0.0; N];
         for (di, wdi) in [(i0, 1.0 - wd), (i1, wd)] {
@@ -132,6 +168,9 @@ impl<const N: usize> Table<N> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Waves {
     pub components: Vec<Component>,
+    /// Each component's transfer functions (and drift coefficients) at its own frequency.
+    pre_rao: Vec<AtFrequency<6>>,
+    pre_drift: Vec<AtFrequency<3>>,
     /// Phases at the vessel's instantaneous position (else at the fixed reference point).
     pub at_vessel: bool,
     pub force_rao: Table<6>,
@@ -295,7 +334,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
             re,
         }
     });
-    let components = (0..om.len())
+    let components: Vec<Component> = (0..om.len())
         .map(|k| Component {
             omega: om[k],
             amplitude: am[k],
@@ -304,12 +343,23 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
             wavenumber: om[k] * om[k] / g,
         })
         .collect();
+    let pre_rao = components_pre(&components, &force_rao);
+    let pre_drift = drift
+        .as_ref()
+        .map(|d| components_pre(&components, d))
+        .unwrap_or_default();
     Ok(Some(Arc::new(Waves {
         components,
+        pre_rao,
+        pre_drift,
         at_vessel,
         force_rao,
         drift,
     })))
+}
+
+fn components_pre<const N: usize>(c: &[Component], t: &Table<N>) -> Vec<AtFrequency<N>> {
+    c.iter().map(|c| t.at_frequency(c.omega)).collect()
 }
 
 const ACCOUNTS: [Account; 2] = [
@@ -342,16 +392,16 @@ impl Waves {
         let mut first = Vector6::zeros();
         let mut s = Vector3::<f64>::zeros();
         let mut mean = Vector3::<f64>::zeros();
-        for c in &self.components {
+        for (k, c) in self.components.iter().enumerate() {
             let th = self.theta(c, x, y, t);
             let (sn, cs) = th.sin_cos();
             let beta = c.direction - psi;
-            let (re, im) = self.force_rao.at(c.omega, beta);
+            let (re, im) = self.force_rao.in_direction(&self.pre_rao[k], beta);
             for n in 0..6 {
                 first[n] += c.amplitude * (re[n] * cs - im[n] * sn);
             }
             if let Some(d) = &self.drift {
-                let (dv, _) = d.at(c.omega, beta);
+                let (dv, _) = d.in_direction(&self.pre_drift[k], beta);
                 for n in 0..3 {
                     s[n] += c.amplitude * dv[n].abs().sqrt() * cs;
                     mean[n] += c.amplitude * c.amplitude * dv[n];
@@ -379,6 +429,10 @@ impl Force for Waves {
     fn add_s2(&self, _fr: &Frozen, _b: &mut S2Builder) {}
     fn forced(&self) -> bool {
         true
+    }
+    /// With the phases at the reference point, the loads depend on time and heading only.
+    fn forcing_uses_state(&self) -> bool {
+        self.at_vessel
     }
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
         let x = if self.at_vessel {
@@ -444,5 +498,11 @@ mod tests {
         assert!((t.at(1.0, 1.5 * PI).0[0] - 10.0).abs() < 1e-12);
         assert!((t.at(1.0, -PI / 2.0).0[0] - 10.0).abs() < 1e-12);
         assert!((t.at(2.0, 2.0 * PI + PI / 2.0).0[0] - 11.0).abs() < 1e-12);
+        // the frequency interpolation done once gives the same values
+        for (w, b) in [(1.3, 0.4), (1.9, 4.0), (1.0, -2.0)] {
+            let pre = t.at_frequency(w);
+            let (a, c) = (t.in_direction(&pre, b).0[0], t.at(w, b).0[0]);
+            assert!((a - c).abs() <= 1e-14 * c.abs().max(1.0), "{a} vs {c}");
+        }
     }
 }
