@@ -13,6 +13,7 @@
 //! * K: within 4 ulp;
 //! * F: within 8 ulp, or twice its own conditioning limit (the table's `sensitivity`: how far F
 //!   moves when φ or m moves one ulp) where that is larger.
+use phsplit_core::flows::rigid_body::{jacobi_short, SHORT_ADVANCE};
 use phsplit_core::lie::elliptic::{ellipf, ellipk, try_jacobi};
 use std::collections::BTreeMap;
 
@@ -127,4 +128,28 @@ fn elliptic_integrals_within_the_issue_16_bounds_over_the_whole_domain() {
     let failures = report("K, F: score = error / allowance", &worst);
     assert!(worst.values().map(|w| w.count).sum::<usize>() > 1_500);
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The flow's short path (issue 17: the Maclaurin series of sn, cn, dn for the small phase
+/// advances of a step) against mpmath, on every row of the table with `0 < |u| ≤ 0.01` and
+/// `0 ≤ m ≤ 1`: within 1 ulp (the AGM path's bound is 8, its measured worst 3).
+#[test]
+fn the_short_path_is_within_one_ulp_of_mpmath() {
+    let text = include_str!("data/jacobi_ref.csv");
+    let (mut n, mut worst) = (0, 0.0f64);
+    for line in text.lines().skip(1) {
+        let c: Vec<&str> = line.split(',').collect();
+        let (u, m) = (parse(c[1]), parse(c[2]));
+        if !(u != 0.0 && u.abs() <= SHORT_ADVANCE && (0.0..=1.0).contains(&m)) {
+            continue;
+        }
+        n += 1;
+        let (s, cn, d) = jacobi_short(u, m);
+        for (x, r) in [(s, parse(c[3])), (cn, parse(c[4])), (d, parse(c[5]))] {
+            worst = worst.max((x - r).abs() / ulp(r));
+        }
+    }
+    println!("short path: {n} rows, worst {worst:.2} ulp");
+    assert!(n > 1000, "{n} rows");
+    assert!(worst <= 1.0, "worst {worst} ulp");
 }

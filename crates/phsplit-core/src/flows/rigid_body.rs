@@ -288,9 +288,47 @@ struct Jacobi {
     d: f64,
 }
 
+/// Below this `|u|` the phase advance is taken from the Maclaurin series (the short path).
+pub const SHORT_ADVANCE: f64 = 0.01;
+
+/// The short path's `(sn, cn, dn)(u | k²)`, `|u| ≤` [`SHORT_ADVANCE`], `0 ≤ k² ≤ 1` (for the
+/// reference tests; the flow uses it through its phase advances).
+pub fn jacobi_short(u: f64, k2: f64) -> (f64, f64, f64) {
+    let j = Jacobi::short(u, k2);
+    (j.s, j.c, j.d)
+}
+
 impl Jacobi {
     fn at(u: f64, k2: f64, k1: f64) -> Self {
+        if u.abs() <= SHORT_ADVANCE {
+            return Self::short(u, k2);
+        }
         let (s, c, d) = jacobi_m1(u, k2, k1);
+        Self { s, c, d }
+    }
+
+    /// The short path (issue 17): `(sn, cn, dn)(u | k²)` for `|u| ≤ 0.01` from their Maclaurin
+    /// series to `u⁷` (DLMF 22.10.1–3):
+    /// `sn = u − (1+k²)u³/3! + (1+14k²+k⁴)u⁵/5! − (1+135k²+135k⁴+k⁶)u⁷/7!`,
+    /// `cn = 1 − u²/2! + (1+4k²)u⁴/4! − (1+44k²+16k⁴)u⁶/6!`,
+    /// `dn = 1 − k²u²/2! + k²(4+k²)u⁴/4! − k²(16+44k²+k⁴)u⁶/6!`.
+    /// The first omitted terms are below `0.034 u⁸ ≤ 3.4e-18` (cn, dn) and `0.022 |u|⁹`
+    /// (sn, relative `2.2e-18`), far under half an ulp for every `k² ∈ [0, 1]`: no AGM, no
+    /// argument reduction. Phase advances of a step are this small whenever `|λ| h ≤ 0.01`
+    /// (the paper's vessel: `|λ| ≈ 1e-3` rad/s at its initial roll).
+    fn short(u: f64, k2: f64) -> Self {
+        let u2 = u * u;
+        let k4 = k2 * k2;
+        let s = u
+            * (1.0
+                - u2 * ((1.0 + k2) / 6.0
+                    - u2 * ((1.0 + 14.0 * k2 + k4) / 120.0
+                        - u2 * (1.0 + 135.0 * k2 + 135.0 * k4 + k4 * k2) / 5040.0)));
+        let c = 1.0
+            - u2 * (0.5
+                - u2 * ((1.0 + 4.0 * k2) / 24.0 - u2 * (1.0 + 44.0 * k2 + 16.0 * k4) / 720.0));
+        let d =
+            1.0 - k2 * u2 * (0.5 - u2 * ((4.0 + k2) / 24.0 - u2 * (16.0 + 44.0 * k2 + k4) / 720.0));
         Self { s, c, d }
     }
 
@@ -638,6 +676,30 @@ mod tests {
         }
         assert!((q - qr).norm() < 1e-8, "attitude error {}", (q - qr).norm());
         assert!(q[(1, 1)] < -0.99, "Q_22 after the flip: {}", q[(1, 1)]);
+    }
+
+    #[test]
+    fn the_short_path_agrees_with_the_elliptic_functions() {
+        // Every k² (including the ends), every |u| up to the threshold: within 4 ulp of the
+        // AGM / Landen evaluation, which is itself within 3 ulp of mpmath; against mpmath the
+        // series is within 1 ulp (tests/elliptic_reference.rs, the rows with |u| ≤ 0.01).
+        let mut worst: f64 = 0.0;
+        for i in 0..=200 {
+            let k2 = i as f64 / 200.0;
+            let k1 = 1.0 - k2;
+            for j in 1..=100 {
+                for sign in [1.0, -1.0] {
+                    let u = sign * SHORT_ADVANCE * (j as f64 / 100.0).powi(3);
+                    let a = Jacobi::short(u, k2);
+                    let (s, c, d) = jacobi_m1(u, k2, k1);
+                    for (x, y) in [(a.s, s), (a.c, c), (a.d, d)] {
+                        let ulp = f64::EPSILON * y.abs().max(f64::MIN_POSITIVE);
+                        worst = worst.max((x - y).abs() / ulp);
+                    }
+                }
+            }
+        }
+        assert!(worst <= 4.0, "{worst} ulp");
     }
 
     #[test]

@@ -157,7 +157,7 @@ fn parameter_from_span(d: f64, x: f64) -> f64 {
         let r = d / a;
         let deriv = (r + (r * (2.0 + r)).sqrt()).ln_1p() - d / (d * (d + 2.0 * a)).sqrt();
         let mut next = a - f / deriv;
-        if !(next > lo && next < hi) || !next.is_finite() {
+        if !(next > lo && next < hi) {
             next = 0.5 * (lo + hi);
         }
         if (next - a).abs() <= 2.0 * f64::EPSILON * a {
