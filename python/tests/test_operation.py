@@ -338,3 +338,23 @@ def test_the_shipped_pipelay_scenario_runs_reruns_and_is_cf_compliant(tmp_path, 
     assert phsplit.results.compare(ds, phsplit.rerun(ds)) == []
     with pytest.raises(phsplit.InvalidInputError, match="neither a file nor a shipped scenario.*pipelay"):
         phsplit.load_scenario("pipelya")
+
+
+def test_the_offset_from_the_route_is_split_across_and_along():
+    """On a straight route along 30 degrees, the cross-track offset is the component of
+    (x - x_d) normal to the route (left positive) and the along-track offset the component along
+    it, recomputed here from the saved positions and desired positions."""
+    d = phsplit.Vessel.paper().to_dict()
+    ang = math.radians(30.0)
+    d["setpoint"] = {"natural_frequency": 0.05, "speed": 0.5, "start_time": 20.0,
+                     "positions": [[780.0, 20.0, 0.0], [780.0 + 500 * math.cos(ang), 20.0 + 500 * math.sin(ang), 0.0]]}
+    v = phsplit.Vessel.from_dict(d)
+    s = phsplit.simulate(v, (0.0, 300.0), 0.5, "sp2", control_start=0.0, save_every=10)
+    o = {k: s.outputs[k][2] for k in s.outputs}
+    ex, ey = s.x[:, 0] - o["setpoint_x"], s.x[:, 1] - o["setpoint_y"]
+    u = np.array([math.cos(ang), math.sin(ang)])
+    np.testing.assert_allclose(o["route_cross_track"], u[0] * ey - u[1] * ex, atol=1e-9)
+    np.testing.assert_allclose(o["route_along_track"], u[0] * ex + u[1] * ey, atol=1e-9)
+    np.testing.assert_allclose(np.hypot(o["route_cross_track"], o["route_along_track"]), o["setpoint_offset"],
+                               atol=1e-9)
+    assert np.abs(o["route_cross_track"]).max() > 1e-3  # the vessel does leave the route

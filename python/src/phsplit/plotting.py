@@ -129,7 +129,11 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     axes = [fig.add_subplot(gs[i, j]) for i in range(rows) for j in (1, 2)]
     ax_pos, ax_head, ax_rp, ax_heave, ax_ctl, ax_en = axes[:6]
     if moving:
-        ax_pos.plot(t, ds["setpoint_offset"].values, lw=1.2)
+        ax_pos.plot(t, ds["setpoint_offset"].values, lw=1.2, label="distance")
+        if "route_cross_track" in ds:
+            ax_pos.plot(t, ds["route_cross_track"].values, lw=1.0, label="across the route")
+            ax_pos.plot(t, ds["route_along_track"].values, lw=1.0, label="along the route")
+            ax_pos.legend(fontsize=8)
         ax_pos.set_ylabel("offset from desired position [m]")
         err = eul[:, 2] - np.degrees(np.asarray(ds["setpoint_heading"].values))
         ax_head.plot(t, (err + 180.0) % 360.0 - 180.0, lw=1.2)

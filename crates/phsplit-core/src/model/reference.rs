@@ -158,6 +158,23 @@ impl Reference {
         std::array::from_fn(|c| self.values[k][c] + self.slope(k, c) * tau)
     }
 
+    /// The route's horizontal direction at `t`: the unit vector from the row before `t` to the
+    /// next one that differs horizontally (the last such leg after the table's end), or `None`
+    /// for a set point that never moves horizontally.
+    pub fn route_direction(&self, t: f64) -> Option<[f64; 2]> {
+        let n = self.times.len();
+        let legs = |k: usize| {
+            let (a, b) = (&self.values[k], &self.values[k + 1]);
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let l = dx.hypot(dy);
+            (l > 0.0).then(|| [dx / l, dy / l])
+        };
+        let k = self.segment(t).min(n.saturating_sub(2));
+        (k..n.saturating_sub(1))
+            .find_map(legs)
+            .or_else(|| (0..k).rev().find_map(legs))
+    }
+
     fn segment(&self, t: f64) -> usize {
         self.times.partition_point(|tk| *tk <= t).saturating_sub(1)
     }

@@ -368,7 +368,13 @@ impl Force for Pid {
             return;
         };
         let d = r.at(t);
-        let off = (s.x.x - d.value[0]).hypot(s.x.y - d.value[1]);
+        let (ex, ey) = (s.x.x - d.value[0], s.x.y - d.value[1]);
+        let off = ex.hypot(ey);
+        // Across and along the route (left of the route positive; along: ahead positive).
+        let (cross, along) = match r.route_direction(t) {
+            Some([ux, uy]) => (ux * ey - uy * ex, ux * ex + uy * ey),
+            None => (off, 0.0),
+        };
         for (name, unit, long_name, value) in [
             (
                 "setpoint_x",
@@ -393,6 +399,18 @@ impl Force for Pid {
                 "m",
                 "horizontal distance of the vessel from the desired position",
                 off,
+            ),
+            (
+                "route_cross_track",
+                "m",
+                "vessel's offset across the route from the desired position (left positive)",
+                cross,
+            ),
+            (
+                "route_along_track",
+                "m",
+                "vessel's offset along the route from the desired position (ahead positive)",
+                along,
             ),
         ] {
             out.push(Output::new(name, unit, long_name, value));
