@@ -247,11 +247,13 @@ def test_the_shipped_dp_weather_scenario_runs_reruns_and_is_cf_compliant(tmp_pat
     out = capsys.readouterr().out
     for src in ("current supplied", "waves supplied", "wave_drift supplied", "wind supplied"):
         assert src in out
+    assert "environment: current 0.50 m/s towards 190 deg; waves jonswap Hs 3 m Tp 9 s" in out
     nc = tmp_path / "dp-weather-t60.nc"
     assert nc.exists() and (tmp_path / "dp-weather-t60.png").exists()
     ds = phsplit.open_dataset(str(nc))
     for name in ("force_waves", "force_wind", "force_current", "wave_elevation", "wind_speed"):
         assert name in ds, name
+    assert ds.attrs["phsplit_environment"].startswith("current 0.50 m/s")
     assert cf_problems(nc) == []
     assert phsplit.results.compare(ds, phsplit.rerun(ds)) == []
     # the scenario's wind coefficients are Blendermann's for an offshore supply vessel

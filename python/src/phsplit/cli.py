@@ -252,6 +252,8 @@ def _simulate(args) -> int:
     print(f"phsplit {phsplit.__version__}: {sc.name}: {sc.method} h={sc.h:g} s on "
           f"[{t0:g}, {t1:g}] s ({n} steps), controller from {ctl}; components: "
           f"{', '.join(sc.vessel.components)}", flush=True)
+    if sc.environment:
+        print(f"environment: {scn.describe_environment(sc.environment)}", flush=True)
     fd, part = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".nc.part")  # unique per run
     os.close(fd)
     t_start = time.perf_counter()
@@ -276,6 +278,7 @@ def _simulate(args) -> int:
             "phsplit_chunks": " ".join(map(str, chunks)),
             "phsplit_scenario_path": args.scenario or "(built in: the paper's Fig. 2)",
             "phsplit_scenario": text if text is not None else "",
+            "phsplit_environment": scn.describe_environment(sc.environment) if sc.environment else "calm water",
             "history": f"{_now()} phsplit {phsplit.__version__}: phsplit {' '.join(args.argv)}",
         }
         for sol in run_chunks(sc.vessel, sc.settings, sc.vessel.initial_state(), chunks):

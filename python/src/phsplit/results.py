@@ -132,6 +132,7 @@ def rerun(source, progress: bool = False):
     out = _joined(sols)
     # The run's own record (the file's), not the first call's: a written rerun reruns again.
     keep = ("phsplit_settings", "phsplit_chunks", "phsplit_vessel", "phsplit_scenario", "phsplit_scenario_path",
+            "phsplit_environment",
             "steps", "status")
     out.attrs.update({k: ds.attrs[k] for k in keep if k in ds.attrs})
     return out

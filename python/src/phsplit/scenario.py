@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import copy
 import difflib
+import math
 import os
 import tomllib
 from dataclasses import dataclass, field
@@ -56,6 +57,8 @@ class Scenario:
     settings: Settings = field(default_factory=Settings)
     name: str = "fig2"
     path: str | None = None
+    #: The scenario's ``[environment]`` table as written (before the sea and wind are realised).
+    environment: dict[str, Any] = field(default_factory=dict)
 
     @classmethod
     def paper_fig2(cls) -> "Scenario":
@@ -71,7 +74,7 @@ class Scenario:
     def replace(self, **kw: Any) -> "Scenario":
         from dataclasses import replace
 
-        return Scenario(self.vessel, replace(self.settings, **kw), self.name, self.path)
+        return Scenario(self.vessel, replace(self.settings, **kw), self.name, self.path, self.environment)
 
 
 def overlay(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
@@ -142,7 +145,35 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
     else:
         vessel = base
     name = checked.get("name") or _name_of_file(path)
-    return Scenario(vessel=vessel, settings=settings, name=name, path=path)
+    env = data.get("environment")
+    return Scenario(vessel=vessel, settings=settings, name=name, path=path,
+                    environment=copy.deepcopy(dict(env)) if isinstance(env, Mapping) else {})
+
+
+def describe_environment(env: Mapping[str, Any]) -> str:
+    """One line for the CLI's summary: the current, the sea state and the wind of a scenario."""
+    parts = []
+    cur = env.get("current")
+    if isinstance(cur, Mapping):
+        if "velocity" in cur:
+            v = [float(x) for x in cur["velocity"]]
+            parts.append(f"current {math.hypot(v[0], v[1]):.2f} m/s towards "
+                         f"{math.degrees(math.atan2(v[1], v[0])) % 360:.0f} deg")
+        elif "times" in cur:
+            parts.append(f"current from a table of {len(cur['times'])} rows")
+    w = env.get("waves")
+    if isinstance(w, Mapping):
+        spread = f", spreading s = {w['spreading']:g}" if "spreading" in w else ", long-crested"
+        parts.append(f"waves {w.get('spectrum', 'jonswap')} Hs {w['hs']:g} m Tp {w['tp']:g} s towards "
+                     f"{w.get('direction', 0.0):g} deg{spread}, {w.get('components', 200)} components, "
+                     f"seed {w.get('seed', 0)}" + (f", transfer functions {w['hydro']}" if "hydro" in w else ""))
+    wd = env.get("wind")
+    if isinstance(wd, Mapping):
+        spec = wd.get("spectrum", "npd")
+        parts.append(f"wind {wd['speed']:g} m/s towards {wd.get('direction', 0.0):g} deg, gusts {spec}"
+                     + (f" (seed {wd.get('seed', 0)})" if spec not in (None, "none") else "")
+                     + (f", {wd['ship_type']} coefficients" if "ship_type" in wd else ""))
+    return "; ".join(parts)
 
 
 #: The scenarios shipped with phsplit (``python/src/phsplit/scenarios``), by name.
