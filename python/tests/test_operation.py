@@ -358,3 +358,58 @@ def test_the_offset_from_the_route_is_split_across_and_along():
     np.testing.assert_allclose(np.hypot(o["route_cross_track"], o["route_along_track"]), o["setpoint_offset"],
                                atol=1e-9)
     assert np.abs(o["route_cross_track"]).max() > 1e-3  # the vessel does leave the route
+
+
+# -- from the review of this session ------------------------------------------------------------
+
+def test_a_heading_table_across_pi_turns_the_short_way():
+    """Headings 3.1 then -3.1 rad: a turn of 0.083 rad through pi, not of 6.2 rad; the heading
+    error is taken the short way round, so the vessel follows it and settles at -3.1 (mod 2 pi)."""
+    d = phsplit.Vessel.paper().to_dict()
+    d["setpoint"] = {"natural_frequency": 0.1, "times": [0.0, 20.0], "interpolation": "step",
+                     "positions": [[780.0, 20.0, 0.0], [780.0, 20.0, 0.0]], "headings": [3.1, -3.1]}
+    v = phsplit.Vessel.from_dict(d)
+    y0 = v.initial_state(euler=[0.0, 0.0, 3.1], position=[780.0, 20.0, 0.0], velocity=[0, 0, 0],
+                         angular_velocity=[0, 0, 0])
+    s = phsplit.simulate(v, (0.0, 600.0), 0.5, "sp4", control_start=0.0, initial=y0, save_every=20)
+    desired = s.outputs["setpoint_heading"][2]
+    assert np.max(np.abs(np.diff(desired))) < 0.1 and abs(desired[-1] - (2 * np.pi - 3.1)) < 1e-6
+    yaw = s.euler[:, 2]
+    err = np.angle(np.exp(1j * (yaw - desired)))
+    assert np.abs(err).max() < 0.05 and abs(err[-1]) < 1e-4
+    assert abs(np.angle(np.exp(1j * (yaw[-1] + 3.1)))) < 1e-4
+
+
+def test_thrusters_allow_steps_beyond_the_d_terms_fixed_point():
+    """The controller's surge, sway and yaw rows stay implicit with thrusters: SP2 at h = 5 and
+    10 s completes on the pipelay scenario (the fixed point alone diverged beyond 4.5 s)."""
+    sc = phsplit.load_scenario("pipelay")
+    for h in (5.0, 10.0):
+        s = phsplit.simulate(sc.vessel, (0.0, 600.0), h, "sp2", control_start=0.0, initial=sc.vessel.initial_state())
+        assert s.status == "completed", (h, s.failure)
+        assert np.all(s.ledger.relative_residual() < 1e-10)
+
+
+def test_a_run_that_loses_its_catenary_fails_cleanly():
+    """A touchdown point 100 km away: the pipe pulls the vessel away at speed until the run
+    blows up; the run then fails with what it had, never with an internal error."""
+    d = phsplit.load_scenario("pipelay").vessel.to_dict()
+    d["pipe"] = {k: v for k, v in d["pipe"].items() if k not in ("horizontal_tension",)}
+    d["pipe"]["touchdown"] = [100780.0, 20.0]
+    v = phsplit.Vessel.from_dict(d)
+    s = phsplit.simulate(v, (0.0, 60.0), 0.5, "sp2", control_start=0.0)
+    assert s.status in ("completed", "failed")
+    if s.status == "failed":
+        assert "non-finite" in s.failure
+
+
+def test_the_watch_circle_follows_a_moving_set_point():
+    sc = phsplit.load_scenario("pipelay")
+    s = phsplit.simulate(sc.vessel, (0.0, 1200.0), 0.5, "sp4", control_start=0.0,
+                         events=[phsplit.events.watch_circle(2.0)])
+    assert s.status == "completed"  # the vessel stays within 1 m of the moving desired position
+    s = phsplit.simulate(sc.vessel, (0.0, 1200.0), 0.5, "sp4", control_start=0.0,
+                         events=[phsplit.events.watch_circle(0.5)])
+    assert s.status == "event"
+    o = sc.vessel._inner.outputs(s.state(-1), float(s.t[-1]))
+    assert abs(math.hypot(s.x[-1, 0] - o["setpoint_x"], s.x[-1, 1] - o["setpoint_y"]) - 0.5) < 1e-6

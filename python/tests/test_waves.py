@@ -280,3 +280,43 @@ def test_blendermann_coefficients_follow_the_published_formula():
     assert at[135.0][2] == pytest.approx(-at[225.0][2])
     with pytest.raises(phsplit.InvalidInputError, match="unknown ship type 'yacht'"):
         sea.blendermann("yacht", 1.0, 1.0, 1.0)
+
+
+@pytest.mark.parametrize("table,words", [
+    ({"hs": 2.0, "tp": 8.0, "direction": "north"}, "direction must be a finite number"),
+    ({"hs": 2.0, "tp": 8.0, "gamma": "3.3"}, r"gamma must lie in \[1, 10\]"),
+    ({"hs": 2.0, "tp": 8.0, "omega_range": [0.3, 1.0, 2.0]}, "omega_range must be two increasing"),
+    ({"hs": 2.0, "tp": 8.0, "omega_range": 2.0}, "omega_range must be two increasing"),
+    ({"hs": True, "tp": 8.0}, "hs must be a number > 0"),
+    ({"hs": 1e-300, "tp": 8.0}, r"hs must lie in \[0.001, 30\] m"),
+    ({"hs": 2.0, "tp": 8.0, "components": True}, "components must be an integer"),
+])
+def test_sea_state_keys_of_the_wrong_type_are_named(table, words):
+    with pytest.raises(phsplit.InvalidInputError, match=words):
+        sea.sea_state(table)
+
+
+@pytest.mark.parametrize("table,words", [
+    ({"speed": 15.0, "direction": "N"}, "direction must be a finite number"),
+    ({"speed": 15.0, "height": "10"}, "height must be a number > 0"),
+    ({"speed": 15.0, "drag": -0.002, "spectrum": "harris"}, "drag must be a number > 0"),
+    ({"speed": 15.0, "omega_range": [0.1]}, "omega_range must be two increasing"),
+    ({"speed": 15.0, "ship_type": "tender", "frontal_area": 10.0, "lateral_area": 30.0, "length": 0.0},
+     "must be numbers > 0"),
+    ({"speed": 15.0, "ship_type": "tender", "frontal_area": 10.0, "lateral_area": 30.0, "length": 20.0,
+      "cx": [1.0]}, "either ship_type or your own cx"),
+])
+def test_wind_keys_of_the_wrong_type_are_named(table, words):
+    with pytest.raises(phsplit.InvalidInputError, match=words):
+        sea.wind(table)
+
+
+def test_symmetric_must_be_a_boolean(tmp_path):
+    os.symlink(DATA, tmp_path / "barge.nc")
+    sc = tmp_path / "s.toml"
+    sc.write_text('[environment.waves]\nhs = 2.0\ntp = 8.0\nomega_range = [0.35, 1.9]\nhydro = "barge.nc"\n'
+                  'symmetric = "false"\n')
+    with pytest.raises(phsplit.ScenarioParseError, match="symmetric must be true or false"):
+        phsplit.load_scenario(str(sc))
+    with pytest.raises(phsplit.InvalidInputError, match="omega must lie within"):
+        hydro.from_capytaine(DATA, omega=5.0)

@@ -130,6 +130,24 @@ impl PyVessel {
         let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;
         Ok(VesselSystem::new(&self.inner, None).natural_periods(&s.q, control))
     }
+    /// What the components report at a flat 27-vector state and time `t` (the pipe's tension,
+    /// the moving set point, ...), with the controller on from `control_start` (None: off):
+    /// `{name: value}`.
+    #[pyo3(signature = (state, t, control_start=None))]
+    fn outputs(
+        &self,
+        state: PyReadonlyArray1<'_, f64>,
+        t: f64,
+        control_start: Option<f64>,
+    ) -> PyResult<std::collections::BTreeMap<String, f64>> {
+        let s = VesselState::from_slice_continuing(&entries(&state)).map_err(to_py)?;
+        let sys = VesselSystem::new(&self.inner, control_start);
+        Ok(sys
+            .outputs(&s, t)
+            .into_iter()
+            .map(|o| (o.name, o.value))
+            .collect())
+    }
     /// The stored energy H of eq. (35) at a flat 27-vector state (J).
     fn energy(&self, state: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
         let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;

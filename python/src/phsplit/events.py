@@ -95,7 +95,8 @@ def _positive(name: str, what: str, v) -> float:
 
 def watch_circle(radius: float, direction: str = "leave", terminal: bool = True) -> Event:
     """The horizontal distance to the controller's set point crosses ``radius`` (m):
-    ``direction="leave"`` (outward, the alarm), ``"enter"`` or ``"both"``."""
+    ``direction="leave"`` (outward, the alarm), ``"enter"`` or ``"both"``. With a moving set
+    point (``[setpoint]``) the circle moves with the desired position of the reference model."""
     r = _positive("watch_circle", "radius (m)", radius)
     if direction not in ("leave", "enter", "both"):
         raise _core.InvalidInputError(f"watch_circle: direction must be 'leave', 'enter' or 'both', got {direction!r}")
@@ -104,7 +105,11 @@ def watch_circle(radius: float, direction: str = "leave", terminal: bool = True)
     def g(t, y, vessel):
         hit = cache.get(id(vessel))
         if hit is None or hit[0] is not vessel:  # the vessel is held, so its id is not reused
-            hit = cache[id(vessel)] = (vessel, _set_point(vessel))
+            moving = "setpoint" in tomllib.loads(vessel.to_toml())
+            hit = cache[id(vessel)] = (vessel, None if moving else _set_point(vessel))
+        if hit[1] is None:
+            o = vessel._inner.outputs(np.ascontiguousarray(y, dtype=float), float(t))
+            return math.hypot(y[18] - o["setpoint_x"], y[19] - o["setpoint_y"]) - r
         ref = hit[1]
         return math.hypot(y[18] - ref[0], y[19] - ref[1]) - r
 

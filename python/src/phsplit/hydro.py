@@ -67,6 +67,9 @@ def from_capytaine(ds, omega: float | None = None, symmetric: bool = False) -> d
     if omega is None:
         a = ds["added_mass"].isel(omega=int(np.argmax(w)))
     else:
+        if not (isinstance(omega, (int, float)) and float(w.min()) <= float(omega) <= float(w.max())):
+            raise _core.InvalidInputError(f"omega must lie within the dataset's frequencies "
+                                          f"[{w.min():g}, {w.max():g}] rad/s, got {omega!r}")
         a = ds["added_mass"].interp(omega=float(omega))
     added = np.asarray(a.sel(influenced_dof=list(DOFS), radiating_dof=list(DOFS)).values, dtype=float)
     f = np.conj(np.asarray(exc.values))  # e^{-iωt} -> e^{+iωt}

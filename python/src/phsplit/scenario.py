@@ -234,8 +234,11 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
             p = src if os.path.isabs(src) else os.path.join(base_dir, src)
             if not os.path.exists(p):
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: the Capytaine dataset {p!r} does not exist")
+            sym = w.get("symmetric", False)
+            if not isinstance(sym, bool):
+                raise _core.ScenarioParseError(f"{path}: environment.waves.symmetric must be true or false, got {sym!r}")
             try:
-                table = hydro.from_capytaine(p, symmetric=bool(w.get("symmetric", False)))["waves"]
+                table = hydro.from_capytaine(p, symmetric=sym)["waves"]
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
         out["waves"] = {**table, **comps}

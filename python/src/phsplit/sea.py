@@ -28,6 +28,18 @@ from . import _core
 SPECTRA = ("jonswap", "pierson-moskowitz")
 
 
+def _number(v) -> bool:
+    """A real number (not a bool, not a string), finite."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _check_range(where: str, r) -> None:
+    ok = (isinstance(r, (tuple, list)) and len(r) == 2 and all(_number(x) for x in r) and 0 < r[0] < r[1])
+    if not ok:
+        raise _core.InvalidInputError(f"{where}: omega_range must be two increasing frequencies > 0 (rad/s), "
+                                      f"got {r!r}")
+
+
 @dataclass(frozen=True)
 class SeaState:
     """A sea state: ``hs`` (m), ``tp`` (s), ``gamma`` (JONSWAP peak enhancement; ignored for
@@ -51,23 +63,25 @@ class SeaState:
             raise _core.InvalidInputError(f"waves: {msg}")
 
         for name, v in (("hs", self.hs), ("tp", self.tp)):
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            if not (_number(v) and v > 0):
                 bad(f"{name} must be a number > 0 ({'m' if name == 'hs' else 's'}), got {v!r}")
+        if self.hs < 1e-3 or self.hs > 30.0:
+            bad(f"hs must lie in [0.001, 30] m (no sea on record is higher), got {self.hs!r}")
         if self.spectrum not in SPECTRA:
             bad(f"spectrum must be one of {', '.join(repr(s) for s in SPECTRA)}, got {self.spectrum!r}")
-        if not (math.isfinite(self.gamma) and 1.0 <= self.gamma <= 10.0):
+        if not (_number(self.gamma) and 1.0 <= self.gamma <= 10.0):
             bad(f"gamma must lie in [1, 10] (the JONSWAP peak enhancement; 3.3 is the mean of JONSWAP), got {self.gamma!r}")
-        if not math.isfinite(self.direction):
-            bad(f"direction must be finite (degrees), got {self.direction!r}")
-        if self.spreading is not None and not (math.isfinite(self.spreading) and self.spreading > 0):
-            bad(f"spreading must be > 0 (the cos-2s exponent) or absent, got {self.spreading!r}")
-        if not (isinstance(self.components, int) and 1 <= self.components <= 10_000):
+        if not _number(self.direction):
+            bad(f"direction must be a finite number (degrees), got {self.direction!r}")
+        if self.spreading is not None and not (_number(self.spreading) and self.spreading > 0):
+            bad(f"spreading must be a number > 0 (the cos-2s exponent) or absent, got {self.spreading!r}")
+        if not (isinstance(self.components, int) and not isinstance(self.components, bool)
+                and 1 <= self.components <= 10_000):
             bad(f"components must be an integer in [1, 10000], got {self.components!r}")
-        if not (isinstance(self.seed, int) and self.seed >= 0):
+        if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0):
             bad(f"seed must be an integer >= 0, got {self.seed!r}")
-        lo, hi = self.range()
-        if not (0 < lo < hi and math.isfinite(hi)):
-            bad(f"omega_range must be two increasing frequencies > 0 (rad/s), got {self.omega_range!r}")
+        if self.omega_range is not None:
+            _check_range("waves", self.omega_range)
 
     @property
     def omega_p(self) -> float:
@@ -145,6 +159,7 @@ def sea_state(table: dict) -> SeaState:
                                            f"({'significant wave height, m' if k == 'hs' else 'peak period, s'})")
     kw = {k: table[k] for k in allowed if k in table}
     if "omega_range" in kw:
+        _check_range("waves", kw["omega_range"])
         kw["omega_range"] = tuple(kw["omega_range"])
     return SeaState(**kw)
 
@@ -200,19 +215,22 @@ class Wind:
         def bad(msg):
             raise _core.InvalidInputError(f"wind: {msg}")
 
-        if not (isinstance(self.speed, (int, float)) and math.isfinite(self.speed) and 0 <= self.speed <= 80):
+        if not (_number(self.speed) and 0 <= self.speed <= 80):
             bad(f"speed must be a number in [0, 80] (m/s), got {self.speed!r}")
+        if not _number(self.direction):
+            bad(f"direction must be a finite number (degrees), got {self.direction!r}")
         if self.spectrum is not None and self.spectrum not in WIND_SPECTRA:
-            bad(f"spectrum must be one of {', '.join(repr(s) for s in WIND_SPECTRA)} or absent, got {self.spectrum!r}")
-        if not (isinstance(self.components, int) and 1 <= self.components <= 10_000):
+            bad(f"spectrum must be one of {', '.join(repr(s) for s in WIND_SPECTRA)} or 'none', got {self.spectrum!r}")
+        if not (isinstance(self.components, int) and not isinstance(self.components, bool)
+                and 1 <= self.components <= 10_000):
             bad(f"components must be an integer in [1, 10000], got {self.components!r}")
-        if not (isinstance(self.seed, int) and self.seed >= 0):
+        if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0):
             bad(f"seed must be an integer >= 0, got {self.seed!r}")
-        lo, hi = self.omega_range
-        if not (0 < lo < hi and math.isfinite(hi)):
-            bad(f"omega_range must be two increasing frequencies > 0 (rad/s), got {self.omega_range!r}")
-        if not (math.isfinite(self.height) and self.height > 0):
-            bad(f"height must be > 0 (m), got {self.height!r}")
+        _check_range("wind", self.omega_range)
+        if not (_number(self.height) and self.height > 0):
+            bad(f"height must be a number > 0 (m), got {self.height!r}")
+        if not (_number(self.drag) and self.drag > 0):
+            bad(f"drag must be a number > 0 (the Harris surface drag coefficient), got {self.drag!r}")
 
     def density(self, omega) -> np.ndarray:
         """The gust spectrum per rad/s at ``omega`` (rad/s)."""
@@ -251,22 +269,25 @@ def wind(table: dict) -> tuple[dict, dict]:
         raise _core.ScenarioParseError("missing field 'speed' in [environment.wind] (mean wind speed at 10 m, m/s)")
     kw = {k: table[k] for k in own if k in table}
     if "omega_range" in kw:
+        _check_range("wind", kw["omega_range"])
         kw["omega_range"] = tuple(kw["omega_range"])
     if kw.get("spectrum") == "none":
         kw["spectrum"] = None
     rest = {k: v for k, v in table.items() if k not in own | {"ship_type", "centroid_x"}}
     if "ship_type" in table:
+        given = [k for k in ("angles", "cx", "cy", "cn") if k in table]
+        if given:
+            raise _core.InvalidInputError(f"environment.wind: ship_type computes the coefficients; give either "
+                                          f"ship_type or your own {', '.join(given)}, not both")
         # Blendermann's coefficients for the ship type, from the windage given with it
         for k in ("frontal_area", "lateral_area", "length"):
             if k not in table:
                 raise _core.ScenarioParseError(f"missing field '{k}' in [environment.wind]: ship_type needs "
                                                "frontal_area, lateral_area and length")
-        try:
-            dims = [float(table[k]) for k in ("frontal_area", "lateral_area", "length")]
-            dims.append(float(table.get("centroid_x", 0.0)))
-        except (TypeError, ValueError):
-            raise _core.InvalidInputError("environment.wind: frontal_area, lateral_area, length and centroid_x "
-                                          "must be numbers (m^2, m^2, m, m)") from None
+        dims = [table[k] for k in ("frontal_area", "lateral_area", "length")] + [table.get("centroid_x", 0.0)]
+        if not (all(_number(x) for x in dims) and all(x > 0 for x in dims[:3])):
+            raise _core.InvalidInputError("environment.wind: frontal_area, lateral_area and length must be numbers "
+                                          f"> 0 (m^2, m^2, m) and centroid_x a number (m), got {dims}")
         rest.update(blendermann(str(table["ship_type"]), *dims))
     return Wind(**kw).realise(), rest
 

@@ -916,7 +916,9 @@ mod tests {
             let wm = so3::pi_e_inv(&th) * s.q;
             let k = |key: &str| if on { Matrix3::from_diagonal(&param(&v, "control", key)) } else { Matrix3::zeros() };
             let xr = param(&v, "control", "position_reference");
-            let te = th - param(&v, "control", "euler_reference");
+            let mut te = th - param(&v, "control", "euler_reference");
+            // the heading error the short way round (pid.rs)
+            te.z = (te.z + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
             let tau_t = -s.q.transpose() * (k("kp_translational") * (s.x - xr) + k("kd_translational") * s.q * vel + k("ki_translational") * s.phi_x);
             let tau_r = -wm.transpose() * (k("kp_rotational") * te + k("kd_rotational") * wm * w + k("ki_rotational") * s.phi_th);
             let grav = scalar(&v, "gravity");

@@ -2,7 +2,9 @@
 //!
 //! Translation: `τ_t = −Qᵀ(Kp (x − x_ref) + Kd Q v + Ki phi_x)`, `phi_x' = x − x_ref`.
 //! Rotation: `τ_r = −Wᵀ(Kp θ_e + Kd W w + Ki phi_th)`, `phi_th' = θ_e = θ − θ_ref`, with
-//! `W = Pi_e(θ)⁻¹ Q` and θ the ZYX Euler angles (eq. 21). Gains are diagonal and ≥ 0.
+//! `W = Pi_e(θ)⁻¹ Q` and θ the ZYX Euler angles (eq. 21). Gains are diagonal and ≥ 0. The
+//! heading component of `θ_e` is taken the short way round, in (−π, π] (phsplit's addition:
+//! the paper's runs never come near ±π, where the unwrapped error would jump by 2π).
 //!
 //! Ledger: the P and I terms are the port, booked as `control` (supplied); the D terms are
 //! dissipation added to D, booked as `control_damping` (`νᵀ D_c ν ≥ 0`). The controller acts
@@ -17,7 +19,8 @@
 //! - `natural_frequency` ω (rad/s, > 0) and `relative_damping` ζ (> 0, default 1: critically
 //!   damped, the filter's step response does not overshoot);
 //! - `positions` (rows of 3 numbers, m, spatial) and optionally `headings` (rad, yaw), one per
-//!   row, with either `times` (s, increasing) or `speed` (m/s, > 0, the rows are waypoints
+//!   row (each turns the short way from the one before: a turn of more than half a circle
+//!   needs rows in between), with either `times` (s, increasing) or `speed` (m/s, > 0, the rows are waypoints
 //!   passed at this speed from `start_time`, s, default 0);
 //! - `interpolation`: `"linear"` (the set point moves at constant speed between rows; the
 //!   default) or `"step"` (it jumps at each row's time).
@@ -168,11 +171,18 @@ fn setpoint(p: &mut Params, euler_reference: &[f64; 3]) -> crate::Result<Option<
             ))
         }
     };
+    // Headings are unwrapped: each row turns the short way from the one before (3.1 then
+    // −3.1 rad is a turn of 0.08 rad, not of 6.2).
+    let mut yaw_prev: Option<f64> = None;
     let values: Vec<[f64; CHANNELS]> = positions
         .iter()
         .enumerate()
         .map(|(k, r)| {
-            let yaw = headings.as_ref().map_or(euler_reference[2], |h| h[k][0]);
+            let mut yaw = headings.as_ref().map_or(euler_reference[2], |h| h[k][0]);
+            if let Some(prev) = yaw_prev {
+                yaw = prev + wrap_pi(yaw - prev);
+            }
+            yaw_prev = Some(yaw);
             [
                 r[0],
                 r[1],
@@ -221,6 +231,16 @@ struct Moving {
     rate: [Vector3<f64>; 2],
 }
 
+/// An angle in (−π, π].
+fn wrap_pi(a: f64) -> f64 {
+    let w = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    if w == -std::f64::consts::PI {
+        std::f64::consts::PI
+    } else {
+        w
+    }
+}
+
 /// `M diag(g)`: column j of `M` times `g_j` (diagonal gains as scalings).
 fn times_diag(m: &Matrix3<f64>, g: &Vector3<f64>) -> Matrix3<f64> {
     let mut out = *m;
@@ -249,7 +269,10 @@ impl Pid {
         };
         // Rotation.
         let (theta, wm) = so3::euler_and_w(&fr.q);
-        let theta_err = theta - self.euler_reference;
+        let mut theta_err = theta - self.euler_reference;
+        // The heading error the short way round (a set point at 3.1 rad and a heading of
+        // −3.1 rad differ by 0.08 rad, not 6.2); roll and pitch never come near ±π.
+        theta_err.z = wrap_pi(theta_err.z);
         let wt = wm.transpose();
         let port_r = Rows {
             fw: -times_diag(&wt, &self.ki_rotational),
@@ -268,6 +291,31 @@ impl Pid {
         }
     }
 
+    /// The controller's surge and sway force rows and its yaw moment row (P, I and D together):
+    /// what thrusters deliver exactly inside their capacity.
+    fn allocated_rows(r: &PidRows) -> (Rows, Rows) {
+        let keep = |rows: &Rows, k: &[usize]| {
+            let mut out = Rows::ZERO;
+            for &i in k {
+                out.fu.set_row(i, &(rows.fu.row(i)));
+                out.fv.set_row(i, &(rows.fv.row(i)));
+                out.fw.set_row(i, &(rows.fw.row(i)));
+                out.c[i] = rows.c[i];
+            }
+            out
+        };
+        let sum = |a: &Rows, b: &Rows| Rows {
+            fu: a.fu + b.fu,
+            fv: a.fv + b.fv,
+            fw: a.fw + b.fw,
+            c: a.c + b.c,
+        };
+        (
+            keep(&sum(&r.port[0], &r.damping[0]), &[0, 1]),
+            keep(&sum(&r.port[1], &r.damping[1]), &[2]),
+        )
+    }
+
     /// What the moving set point changes at `t` (none without one).
     fn moving(&self, fr: &Frozen, t: f64) -> Option<Moving> {
         let r = self.setpoint.as_ref()?;
@@ -279,8 +327,12 @@ impl Pid {
         let dx = xd - self.position_reference;
         let force = fr.qt
             * (self.kp_translational.component_mul(&dx) + self.kd_translational.component_mul(&vd));
-        let (_, wm) = so3::euler_and_w(&fr.q);
-        let dth = th - self.euler_reference;
+        let (theta, wm) = so3::euler_and_w(&fr.q);
+        let mut dth = th - self.euler_reference;
+        // With the affine part's heading error e0 = wrap(θ − θ_ref), the total error e0 − dth
+        // is taken the short way round too: dth is shifted by whole turns so that it is.
+        let e0 = wrap_pi(theta.z - self.euler_reference.z);
+        dth.z = e0 - wrap_pi(e0 - dth.z);
         let moment = wm.transpose()
             * (self.kp_rotational.component_mul(&dth) + self.kd_rotational.component_mul(&thd));
         Some(Moving {
@@ -438,8 +490,10 @@ impl Force for Pid {
             Some(th) => {
                 let (f, m) = self.demand(fr, t, z);
                 let a = th.allocate(&Vector3::new(f.x, f.y, m.z));
-                g.force(Sys::Trans, Some(0), a.force);
-                g.force(Sys::Rot, Some(0), a.moment);
+                // What the thrusters deliver, less the affine part already in flow S2.
+                let (rt, rr) = Self::allocated_rows(&self.rows(fr));
+                g.force(Sys::Trans, Some(0), a.force - rt.at(&z[0]));
+                g.force(Sys::Rot, Some(0), a.moment - rr.at(&z[1]));
             }
         }
     }
@@ -464,6 +518,14 @@ impl Force for Pid {
                 b.force(sys, port, &r.port[k]);
                 b.force(sys, damp, &r.damping[k]);
             }
+        } else {
+            // Inside their capacity the thrusters deliver the demand's surge, sway and yaw
+            // exactly: that part stays affine (implicit in the collocation, so the fixed point
+            // converges at any step the D term allows); the forcing carries the rest (the
+            // moving set point, the heel and trim of the thrusters' arms, saturation).
+            let (t, rot) = Self::allocated_rows(&r);
+            b.force(Sys::Trans, Some(0), &t);
+            b.force(Sys::Rot, Some(0), &rot);
         }
         let t = b.rows(Sys::Trans);
         t.awv += Matrix3::identity();

@@ -186,11 +186,13 @@ const ACCOUNTS: [Account; 1] = [Account {
 }];
 
 impl Pipe {
-    /// The pipe with the vessel at position `x` (m) and attitude `q`, at time `t` (s).
+    /// The pipe with the vessel at position `x` (m) and attitude `q`, at time `t` (s). A pose
+    /// that puts the hang-off point at or below the seabed, or a non-finite one (a run that
+    /// has blown up), has no catenary: the state is then NaN, and a run that meets it fails
+    /// with what it had (never a panic).
     pub fn state_at(&self, x: &Vector3<f64>, q: &Matrix3<f64>, t: f64) -> PipeState {
         let top = x + q * self.hang_off;
-        // A hang-off point at or below the seabed (never in a sane run) is held just above it.
-        let d = (self.water_depth + top.z).max(1e-6 * self.water_depth);
+        let d = self.water_depth + top.z;
         let w = self.weight;
         let horizontal = Vector2::new(top.x, top.y);
         let (cat, e) = match self.mode {
@@ -216,7 +218,18 @@ impl Pipe {
                 (Catenary::from_span(w, d, span), e)
             }
         };
-        let cat = cat.expect("inputs checked at build and held in range");
+        let nan = Vector3::from_element(f64::NAN);
+        let Ok(cat) = cat else {
+            return PipeState {
+                catenary: Catenary {
+                    weight: w,
+                    height: d,
+                    horizontal_tension: f64::NAN,
+                },
+                touchdown: Vector2::from_element(f64::NAN),
+                force: nan,
+            };
+        };
         let touchdown = horizontal - e * cat.span();
         let h = cat.horizontal_tension;
         let force = Vector3::new(-h * e.x, -h * e.y, -cat.vertical_tension());
