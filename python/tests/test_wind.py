@@ -191,3 +191,8 @@ def test_with_all_loads_sp2_at_h_1_stays_within_its_passivity_bound_for_an_hour(
     scale = np.cumsum(sum(np.abs(b) for b in s.ledger.by_account.values()))
     assert np.all(s.energy <= s.energy[0] + supplied + 1e-10 * scale + 1e-9)
     assert np.all(s.ledger.dissipated[1:] >= 0)
+
+
+def test_an_unknown_key_in_environment_wind_is_named_there():
+    with pytest.raises(phsplit.ScenarioParseError, match=r"unknown field 'speeed' in \[environment.wind\]; did you mean 'speed'"):
+        sea.wind({"speeed": 15.0})

@@ -265,6 +265,16 @@ def wind(table: dict) -> tuple[dict, dict]:
     """A scenario's ``[environment.wind]``: the realised wind keys, and the rest (the windage
     and coefficients), which go to the vessel's ``[wind]`` table unchanged."""
     own = {"speed", "direction", "spectrum", "seed", "components", "omega_range", "height", "drag"}
+    windage = {"ship_type", "centroid_x", "frontal_area", "lateral_area", "length", "air_density", "angles", "cx",
+               "cy", "cn"}
+    unknown = sorted(set(table) - own - windage)
+    if unknown:
+        import difflib
+
+        near = difflib.get_close_matches(unknown[0], sorted(own | windage), n=1)
+        hint = f"; did you mean {near[0]!r}?" if near else ""
+        raise _core.ScenarioParseError(f"unknown field {unknown[0]!r} in [environment.wind]{hint} "
+                                       f"(allowed: {', '.join(sorted(own | windage))})")
     if "speed" not in table:
         raise _core.ScenarioParseError("missing field 'speed' in [environment.wind] (mean wind speed at 10 m, m/s)")
     kw = {k: table[k] for k in own if k in table}
