@@ -207,6 +207,13 @@ class _DeferSignals:
         return False
 
 
+def _components(vessel) -> str:
+    """The vessel's components for the summary, the controller's set point and thrusters named."""
+    tables = vessel.to_dict()
+    extra = [name for key, name in (("setpoint", "moving set point"), ("thrusters", "thrusters")) if key in tables]
+    return ", ".join(f"pid ({', '.join(extra)})" if c == "pid" and extra else c for c in vessel.components)
+
+
 def _simulate(args) -> int:
     import phsplit
     from . import scenario as scn
@@ -251,7 +258,7 @@ def _simulate(args) -> int:
     ctl = "never" if sc.control_start is None else f"t={sc.control_start:g} s"
     print(f"phsplit {phsplit.__version__}: {sc.name}: {sc.method} h={sc.h:g} s on "
           f"[{t0:g}, {t1:g}] s ({n} steps), controller from {ctl}; components: "
-          f"{', '.join(sc.vessel.components)}", flush=True)
+          f"{_components(sc.vessel)}", flush=True)
     if sc.environment:
         print(f"environment: {scn.describe_environment(sc.environment)}", flush=True)
     fd, part = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".nc.part")  # unique per run

@@ -223,7 +223,7 @@ impl Thrusters {
         let (lo, hi) = (eig.min(), eig.max());
         if !(lo > 1e-12 * hi) {
             return Err(Error::InvalidInput(format!(
-                "the thrusters cannot produce surge, sway and yaw independently (the allocation matrix has rank < 3: smallest singular value ratio {:.1e}); add a thruster or move one off the line of the others",
+                "the thrusters cannot produce surge, sway and yaw independently (the allocation matrix has rank < 3: smallest singular value ratio {:.1e}); add a thruster or move one off the line of the others, and keep the thrusters' weights within a few decades of each other",
                 (lo.max(0.0) / hi).sqrt()
             )));
         }
