@@ -39,10 +39,6 @@ HULLS = {
 THETA = np.linspace(-np.pi / 6, 2 * np.pi + np.pi / 6, 121)
 
 
-def hull_name(_mesh) -> str:
-    return "box"
-
-
 def main(out: str, hull: str = "box_barge") -> None:
     import capytaine as cpt
 
@@ -52,28 +48,19 @@ def main(out: str, hull: str = "box_barge") -> None:
     mesh = cpt.mesh_parallelepiped(size=(length, beam, draft), resolution=res, center=(0.0, 0.0, -draft / 2))
     hull = mesh.immersed_part()
     body = cpt.FloatingBody(mesh=hull, dofs=cpt.rigid_body_dofs(rotation_center=(0.0, 0.0, 0.0)),
-                            center_of_mass=(0.0, 0.0, 0.0), name=hull_name(hull))
+                            center_of_mass=(0.0, 0.0, 0.0), name="box")
     body.inertia_matrix = body.compute_rigid_body_inertia()
     body.hydrostatic_stiffness = body.compute_hydrostatic_stiffness()
-    test_matrix = cpt.xr.Dataset(coords={
+    import xarray as xr
+
+    test_matrix = xr.Dataset(coords={
         "omega": omegas,
         "wave_direction": np.radians(dirs),
         "radiating_dof": list(body.dofs),
         "water_depth": [np.inf],
         "rho": [1025.0],
         "theta": THETA,
-    }) if hasattr(cpt, "xr") else None
-    import xarray as xr
-
-    if test_matrix is None:
-        test_matrix = xr.Dataset(coords={
-            "omega": omegas,
-            "wave_direction": np.radians(dirs),
-            "radiating_dof": list(body.dofs),
-            "water_depth": [np.inf],
-            "rho": [1025.0],
-            "theta": THETA,
-        })
+    })
     ds = cpt.BEMSolver().fill_dataset(test_matrix, body)
     # Mean drift (far field, Maruo) of the free-floating body in regular waves, per square metre of
     # amplitude: the diagonal (k = l) of Capytaine's bichromatic table. DP does not act at wave

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import phsplit
-import reference as ref
+from checks import fitted_order
 
 mp.mp.dps = 30
 
@@ -191,16 +191,8 @@ def test_orders_with_the_pipe_and_a_moving_set_point_against_the_independent_mod
     else:
         y0 = v.initial_state()
         y0[0:3] = [2e6, -1e6, 0.0]
-    _, y = ref.solve(v.to_dict(), y0, 2.0, 0.0, rtol=1e-13)
-    pe, xe = y[-1][0:3], y[-1][18:21]
-    hs, errs = 2.0 ** -np.arange(1, 6), []
-    for h in hs:
-        s = phsplit.simulate(v, (0.0, 2.0), h, method, control_start=0.0, ledger=False, initial=y0,
-                             project_invariants=False)
-        errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
-    errs = np.array(errs)
-    keep = errs > 1e-13
-    slope = np.polyfit(np.log(hs[keep]), np.log(errs[keep]), 1)[0]
+    slope, errs, y_end = fitted_order(v, y0, method, 2.0 ** -np.arange(1, 6))
+    xe = y_end[18:21]
     assert abs(slope - order) < 0.2, (slope, errs)
     s = phsplit.simulate(v, (0.0, 2.0), 2.0 ** -5, method, control_start=0.0, ledger=False, initial=y0)
     assert np.linalg.norm(s.x[-1] - xe) < (1e-4 if order == 2 else 1e-7)

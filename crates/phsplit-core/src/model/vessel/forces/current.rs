@@ -24,6 +24,7 @@
 use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
+use crate::model::grid::check_increasing;
 use crate::model::vessel::params::{Params, Range};
 use crate::solve::{Account, AccountKind};
 use nalgebra::Vector3;
@@ -61,13 +62,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
                 )));
             }
             let t: Vec<f64> = t.into_iter().map(|r| r[0]).collect();
-            if let Some(i) = (1..t.len()).find(|&i| t[i] <= t[i - 1]) {
-                return Err(Error::InvalidInput(format!(
-                    "current.times must increase strictly (s): times[{i}] = {} after {}",
-                    t[i],
-                    t[i - 1]
-                )));
-            }
+            check_increasing("current.times", &t, "s")?;
             for (k, r) in v.iter().enumerate() {
                 for (i, x) in r.iter().enumerate() {
                     if x.abs() > MAX_SPEED {

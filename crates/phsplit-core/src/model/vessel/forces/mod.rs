@@ -113,6 +113,10 @@ pub struct Frozen<'a> {
     pub qt: Matrix3<f64>,
     /// `q3 = Q0ᵀ e3`, the vertical in the body frame.
     pub q3: Vector3<f64>,
+    /// The ZYX Euler angles of `Q0` (eq. 21) and `W = Pi_e(θ)⁻¹ Q0` (`θ' = W w`), computed once
+    /// per sub-step for every component that needs them.
+    pub euler: Vector3<f64>,
+    pub w: Matrix3<f64>,
     /// The origin `x_o` of the translational block's position, `v = x − x_o` (m).
     pub origin: Vector3<f64>,
     /// Whether the controller acts on this step.

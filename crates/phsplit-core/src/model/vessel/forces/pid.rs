@@ -34,7 +34,6 @@ use super::thrusters::{self, Thrusters};
 use super::{Force, Forcing, Frozen, Output, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
-use crate::lie::so3;
 use crate::model::reference::{Interpolation, Reference, CHANNELS};
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
@@ -268,7 +267,7 @@ impl Pid {
             ..Rows::ZERO
         };
         // Rotation.
-        let (theta, wm) = so3::euler_and_w(&fr.q);
+        let (theta, wm) = (fr.euler, fr.w);
         let mut theta_err = theta - self.euler_reference;
         // The heading error the short way round (a set point at 3.1 rad and a heading of
         // −3.1 rad differ by 0.08 rad, not 6.2); roll and pitch never come near ±π.
@@ -327,7 +326,7 @@ impl Pid {
         let dx = xd - self.position_reference;
         let force = fr.qt
             * (self.kp_translational.component_mul(&dx) + self.kd_translational.component_mul(&vd));
-        let (theta, wm) = so3::euler_and_w(&fr.q);
+        let (theta, wm) = (fr.euler, fr.w);
         let mut dth = th - self.euler_reference;
         // With the affine part's heading error e0 = wrap(θ − θ_ref), the total error e0 − dth
         // is taken the short way round too: dth is shifted by whole turns so that it is.
@@ -344,10 +343,14 @@ impl Pid {
 
     /// The controller's demand (force, moment; body frame) at block states `z` and time `t`.
     pub fn demand(&self, fr: &Frozen, t: f64, z: &[Z3; 2]) -> (Vector3<f64>, Vector3<f64>) {
-        let r = self.rows(fr);
+        Self::demand_of(&self.rows(fr), self.moving(fr, t).as_ref(), z)
+    }
+
+    /// The demand from the rows and the moving set point's part, already evaluated.
+    fn demand_of(r: &PidRows, mv: Option<&Moving>, z: &[Z3; 2]) -> (Vector3<f64>, Vector3<f64>) {
         let mut f = r.port[0].at(&z[0]) + r.damping[0].at(&z[0]);
         let mut m = r.port[1].at(&z[1]) + r.damping[1].at(&z[1]);
-        if let Some(mv) = self.moving(fr, t) {
+        if let Some(mv) = mv {
             f += mv.force;
             m += mv.moment;
         }
@@ -488,12 +491,13 @@ impl Force for Pid {
                 }
             }
             Some(th) => {
-                let (f, m) = self.demand(fr, t, z);
-                let a = th.allocate(&Vector3::new(f.x, f.y, m.z));
+                let r = self.rows(fr);
+                let (f, m) = Self::demand_of(&r, mv.as_ref(), z);
+                let (force, moment) = th.wrench(&Vector3::new(f.x, f.y, m.z));
                 // What the thrusters deliver, less the affine part already in flow S2.
-                let (rt, rr) = Self::allocated_rows(&self.rows(fr));
-                g.force(Sys::Trans, Some(0), a.force - rt.at(&z[0]));
-                g.force(Sys::Rot, Some(0), a.moment - rr.at(&z[1]));
+                let (rt, rr) = Self::allocated_rows(&r);
+                g.force(Sys::Trans, Some(0), force - rt.at(&z[0]));
+                g.force(Sys::Rot, Some(0), moment - rr.at(&z[1]));
             }
         }
     }

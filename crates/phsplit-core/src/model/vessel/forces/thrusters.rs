@@ -72,6 +72,8 @@ pub struct Thrusters {
     /// Per allocation variable: its unit, its direction in the body's x–y plane, and its row
     /// of the weighted pseudo-inverse (`f_j = p_j · τ`).
     vars: Vec<(usize, Vector2<f64>, Vector3<f64>)>,
+    /// Each unit's variables, `vars[start..end]` (contiguous).
+    ranges: Vec<(usize, usize)>,
 }
 
 /// One allocation: what each thruster gives and what the vessel receives.
@@ -228,68 +230,103 @@ impl Thrusters {
             )));
         }
         let inv = bwb.try_inverse().expect("checked positive definite");
-        let vars = cols
+        let vars: Vec<_> = cols
             .into_iter()
             .map(|(i, d, b, w)| (i, d, inv * b / w))
             .collect();
-        Ok(Self { units, vars })
+        let ranges = (0..units.len())
+            .map(|u| {
+                let start = vars.iter().position(|v| v.0 == u).unwrap_or(vars.len());
+                let len = vars.iter().filter(|v| v.0 == u).count();
+                (start, start + len)
+            })
+            .collect();
+        Ok(Self {
+            units,
+            vars,
+            ranges,
+        })
     }
 
-    /// Allocate the demand `(X, Y, N)`.
-    pub fn allocate(&self, tau: &Vector3<f64>) -> Allocation {
-        let n = self.units.len();
-        let mut fx = vec![0.0; n];
-        let mut fy = vec![0.0; n];
-        let mut along = vec![0.0; n];
-        for (i, d, p) in &self.vars {
+    /// Thruster `i`'s unscaled force `(f_x, f_y)` for the demand `tau`, and its thrust along
+    /// its axis (tunnel, fixed; 0 for an azimuth).
+    fn unit_force(&self, i: usize, tau: &Vector3<f64>) -> (f64, f64, f64) {
+        let (mut fx, mut fy, mut along) = (0.0, 0.0, 0.0);
+        for (_, d, p) in &self.vars[self.ranges[i].0..self.ranges[i].1] {
             let f = p.dot(tau);
-            fx[*i] += f * d.x;
-            fy[*i] += f * d.y;
-            if self.units[*i].kind != Kind::Azimuth {
-                along[*i] = f;
-            }
+            fx += f * d.x;
+            fy += f * d.y;
+            along = f;
         }
-        // The largest scaling that keeps every thruster within its limits.
+        if self.units[i].kind == Kind::Azimuth {
+            along = 0.0;
+        }
+        (fx, fy, along)
+    }
+
+    /// The largest scaling `c ∈ (0, 1]` of the least-norm solution that keeps every thruster
+    /// within its limits.
+    fn scale(&self, tau: &Vector3<f64>) -> f64 {
         let mut c: f64 = 1.0;
         for (i, u) in self.units.iter().enumerate() {
+            let (fx, fy, along) = self.unit_force(i, tau);
             match u.kind {
                 Kind::Azimuth => {
-                    let m = fx[i].hypot(fy[i]);
+                    let m = fx.hypot(fy);
                     if m > u.max_thrust {
                         c = c.min(u.max_thrust / m);
                     }
                 }
                 _ => {
-                    let f = along[i];
-                    if f > u.max_thrust {
-                        c = c.min(u.max_thrust / f);
-                    } else if f < u.min_thrust {
-                        c = c.min(u.min_thrust / f);
+                    if along > u.max_thrust {
+                        c = c.min(u.max_thrust / along);
+                    } else if along < u.min_thrust {
+                        c = c.min(u.min_thrust / along);
                     }
                 }
             }
         }
+        c
+    }
+
+    /// The delivered force and moment (body frame, about the body origin) for the demand
+    /// `(X, Y, N)`: [`Self::allocate`]'s wrench without its per-thruster record (no allocation:
+    /// flow S2 evaluates it at every stage).
+    pub fn wrench(&self, tau: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let c = self.scale(tau);
+        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+        for (i, u) in self.units.iter().enumerate() {
+            let (fx, fy, _) = self.unit_force(i, tau);
+            let f = Vector3::new(fx * c, fy * c, 0.0);
+            force += f;
+            moment += u.position.cross(&f);
+        }
+        (force, moment)
+    }
+
+    /// Allocate the demand `(X, Y, N)`, with each thruster's thrust and angle.
+    pub fn allocate(&self, tau: &Vector3<f64>) -> Allocation {
+        let n = self.units.len();
+        let c = self.scale(tau);
         let mut thrust = Vec::with_capacity(n);
         let mut angle = Vec::with_capacity(n);
         let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
         let mut util: f64 = 0.0;
         for (i, u) in self.units.iter().enumerate() {
-            let f = Vector3::new(fx[i] * c, fy[i] * c, 0.0);
+            let (fx, fy, along) = self.unit_force(i, tau);
+            let f = Vector3::new(fx * c, fy * c, 0.0);
             force += f;
             moment += u.position.cross(&f);
             let (t, a, lim) = match u.kind {
                 Kind::Azimuth => (f.x.hypot(f.y), f.y.atan2(f.x), u.max_thrust),
                 _ => {
-                    let t = along[i] * c;
-                    (
-                        t,
-                        u.angle,
-                        if t >= 0.0 {
-                            u.max_thrust
-                        } else {
-                            -u.min_thrust
-                        },
-                    )
+                    let t = along * c;
+                    let lim = if t >= 0.0 {
+                        u.max_thrust
+                    } else {
+                        -u.min_thrust
+                    };
+                    (t, u.angle, lim)
                 }
             };
             util = util.max(t.abs() / lim);
@@ -351,6 +388,7 @@ mod tests {
             Vector3::new(0.0, -1e5, -5e6),
         ] {
             let a = th.allocate(&tau);
+            assert_eq!(th.wrench(&tau), (a.force, a.moment));
             assert_eq!(a.scale, 1.0);
             assert!((a.delivered - tau).norm() <= 1e-12 * tau.norm(), "{a:?}");
         }
@@ -361,6 +399,7 @@ mod tests {
         let th = osv();
         let tau = Vector3::new(3e6, 1e6, 4e7);
         let a = th.allocate(&tau);
+        assert_eq!(th.wrench(&tau), (a.force, a.moment));
         assert!(a.scale < 1.0);
         let cos = a.delivered.dot(&tau) / (a.delivered.norm() * tau.norm());
         assert!(cos > (1e-9f64).cos() - 1e-15, "{cos}");

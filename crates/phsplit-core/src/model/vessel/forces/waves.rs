@@ -45,11 +45,11 @@ use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::lie::so3;
+use crate::model::grid::{check_increasing, check_periodic, periodic_weights};
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
 use crate::solve::{Account, AccountKind};
 use nalgebra::{Vector3, Vector6};
-use std::f64::consts::TAU;
 use std::sync::Arc;
 use toml::Value;
 
@@ -113,24 +113,7 @@ impl<const N: usize> Table<N> {
 
     /// The two directions around `beta` and the weight of the second.
     fn direction_weights(&self, beta: f64) -> (usize, usize, f64) {
-        let d = &self.directions;
-        let nd = d.len();
-        if nd == 1 {
-            return (0, 0, 0.0);
-        }
-        let b = d[0] + (beta - d[0]).rem_euclid(TAU);
-        let i = d.partition_point(|x| *x <= b);
-        if i == 0 || i == nd {
-            let (lo, hi) = (d[nd - 1], d[0] + TAU);
-            let bb = if b < d[nd - 1] { b + TAU } else { b };
-            (nd - 1, 0, ((bb - lo) / (hi - lo)).clamp(0.0, 1.0))
-        } else {
-            (
-                i - 1,
-                i,
-                ((b - d[i - 1]) / (d[i] - d[i - 1])).clamp(0.0, 1.0),
-            )
-        }
+        periodic_weights(&self.directions, beta)
     }
 
     /// The interpolated (re, im) at `omega` (inside the frequency range) and relative
@@ -279,22 +262,8 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
             "waves.rao_frequencies and waves.rao_directions need at least one value each".into(),
         ));
     }
-    for (name, v) in [("rao_frequencies", &rf), ("rao_directions", &rd)] {
-        if let Some(i) = (1..v.len()).find(|&i| v[i] <= v[i - 1]) {
-            return Err(Error::InvalidInput(format!(
-                "waves.{name} must increase strictly: [{i}] = {} after {}",
-                v[i],
-                v[i - 1]
-            )));
-        }
-    }
-    if rd[rd.len() - 1] - rd[0] >= 360.0 {
-        return Err(Error::InvalidInput(format!(
-            "waves.rao_directions must span less than 360 degrees (the grid is periodic), got {} to {}",
-            rd[0],
-            rd[rd.len() - 1]
-        )));
-    }
+    check_increasing("waves.rao_frequencies", &rf, "rad/s")?;
+    check_periodic("waves.rao_directions", &rd)?;
     let (lo, hi) = (rf[0], rf[rf.len() - 1]);
     if let Some(k) = om
         .iter()
@@ -440,7 +409,7 @@ impl Force for Waves {
         } else {
             fr.origin
         };
-        let psi = so3::euler_and_w(&fr.q).0.z;
+        let psi = fr.euler.z;
         let (first, drift) = self.loads(x.x, x.y, psi, t);
         // The loads are given in the seakeeping frame (x along the heading, z up: it follows the
         // mean heading, not the oscillations); on the body: Qᵀ R_z(ψ).

@@ -30,11 +30,11 @@
 use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
+use crate::model::grid::{check_periodic, periodic_weights};
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
 use crate::solve::{Account, AccountKind};
 use nalgebra::Vector3;
-use std::f64::consts::TAU;
 use std::sync::Arc;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -119,20 +119,7 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
             cn.len()
         )));
     }
-    if let Some(i) = (1..angles.len()).find(|&i| angles[i] <= angles[i - 1]) {
-        return Err(Error::InvalidInput(format!(
-            "wind.angles must increase strictly (degrees): angles[{i}] = {} after {}",
-            angles[i],
-            angles[i - 1]
-        )));
-    }
-    if angles[angles.len() - 1] - angles[0] >= 360.0 {
-        return Err(Error::InvalidInput(format!(
-            "wind.angles must span less than 360 degrees (the table is periodic), got {} to {}",
-            angles[0],
-            angles[angles.len() - 1]
-        )));
-    }
+    check_periodic("wind.angles", &angles)?;
     Ok(Some(Arc::new(Wind {
         speed,
         direction,
@@ -165,19 +152,7 @@ impl Wind {
 
     /// The coefficients at the relative angle `gamma` (rad), periodic linear interpolation.
     pub fn coefficients_at(&self, gamma: f64) -> [f64; 3] {
-        let a = &self.angles;
-        let n = a.len();
-        if n == 1 {
-            return self.coefficients[0];
-        }
-        let b = a[0] + (gamma - a[0]).rem_euclid(TAU);
-        let i = a.partition_point(|x| *x <= b);
-        let (i0, i1, w) = if i == 0 || i == n {
-            let bb = if b < a[n - 1] { b + TAU } else { b };
-            (n - 1, 0, (bb - a[n - 1]) / (a[0] + TAU - a[n - 1]))
-        } else {
-            (i - 1, i, (b - a[i - 1]) / (a[i] - a[i - 1]))
-        };
+        let (i0, i1, w) = periodic_weights(&self.angles, gamma);
         let (c0, c1) = (self.coefficients[i0], self.coefficients[i1]);
         std::array::from_fn(|k| c0[k] * (1.0 - w) + c1[k] * w)
     }
