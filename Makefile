@@ -16,7 +16,7 @@ run: $(VENV)/.built
 test: test-rust test-python
 
 test-rust:
-	cargo test -p phsplit-core --release
+	cargo test -p phsplit-core -p phsplit-fmu --release
 
 test-python: $(VENV)/.built
 	$(BIN)/python -m pytest -q python/tests
@@ -29,7 +29,13 @@ $(VENV)/.deps: python/requirements-dev.txt
 	$(BIN)/python -m pip install --quiet -r python/requirements-dev.txt
 	touch $@
 
+# The FMU's binary (crates/phsplit-fmu, no Python inside) is shipped in the package, next to
+# the extension module, for `phsplit fmu export` (docs/fmu.md).
+FMU_BIN := python/src/phsplit/_fmu/binaries/linux64/phsplit_fmu.so
+
 $(VENV)/.built: $(VENV)/.deps $(RUST_SRC) python/pyproject.toml
+	cargo build -p phsplit-fmu --release
+	mkdir -p $(dir $(FMU_BIN)) && cp target/release/libphsplit_fmu.so $(FMU_BIN)
 	cd python && VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(BIN)):$$PATH $(abspath $(BIN))/maturin develop --release --quiet
 	touch $@
 

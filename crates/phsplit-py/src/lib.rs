@@ -6,6 +6,7 @@
 //! boundary: every fallible call returns `PyResult`, and a panic in the core is caught.
 
 mod convert;
+mod fmu;
 mod numerics;
 mod run;
 
@@ -338,6 +339,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyVessel>()?;
     run::register(m)?;
     m.add_function(wrap_pyfunction!(method_info, m)?)?;
+    m.add_function(wrap_pyfunction!(fmu::fmu_variables, m)?)?;
     m.add_function(wrap_pyfunction!(euler_zyx, m)?)?;
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(check_settings, m)?)?;

@@ -21,6 +21,8 @@ EXAMPLES = """examples:
   phsplit sweep gains.toml --scheduler tcp://10.0.0.5:8786  # ... on an existing Dask cluster
   phsplit rerun out/fig2.nc                # rerun what a result file records, check it bit for bit
   phsplit plot out/fig2.nc --watch-circle 5  # the DP figure of a result file
+  phsplit fmu export -o vessel.fmu         # an FMI 2.0 co-simulation FMU of the Fig. 2 vessel
+  phsplit fmu export pipelay -o pipelay.fmu  # ... of a shipped scenario's vessel and settings
 """
 
 
@@ -106,6 +108,29 @@ def _parser() -> argparse.ArgumentParser:
     pl.add_argument("file", help="a NetCDF file written by phsplit")
     pl.add_argument("--out", help="the image to write (default: FILE with .png; .pdf and .svg work too)")
     pl.add_argument("--watch-circle", type=float, help="radius of the watch circle about the set point, m")
+    fm = sub.add_parser(
+        "fmu",
+        help="export a vessel (or a load source) as an FMI 2.0 co-simulation FMU",
+        description="Write an FMI 2.0 co-simulation FMU for FMPy, OSP's libcosim and other FMI hosts "
+        "(docs/fmu.md). 'export' packs a scenario's vessel and settings with phsplit's compiled core "
+        "(no Python inside); 'load' packs a periodic force and moment source to couple with it.",
+        epilog="examples:\n  phsplit fmu export -o vessel.fmu\n  phsplit fmu export dp-weather -o dp.fmu\n"
+        "  phsplit fmu export scenario.toml -o my.fmu --binary win64=target/x86_64-pc-windows-gnu/release/phsplit_fmu.dll\n"
+        "  phsplit fmu load -o load.fmu --force-mean 2e5 0 0 --force-amplitude 1e5 5e4 0 --period 40",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    fsub = fm.add_subparsers(dest="fmu_command", metavar="FMU_COMMAND")
+    fe = fsub.add_parser("export", help="a scenario's vessel and settings as an FMU")
+    fe.add_argument("scenario", nargs="?", help="scenario TOML file or shipped scenario name (default: the paper's Fig. 2)")
+    fe.add_argument("-o", "--out", default="vessel.fmu", help="the FMU to write (default: vessel.fmu)")
+    fe.add_argument("--binary", action="append", default=[], metavar="PLATFORM=PATH",
+                    help="add a binary built for another platform (win64, darwin64, linux32, ...); repeatable")
+    fl = fsub.add_parser("load", help="a periodic load source FMU: mean + amplitude sin(2 pi t / period)")
+    fl.add_argument("-o", "--out", default="load.fmu", help="the FMU to write (default: load.fmu)")
+    for k, unit in (("force-mean", "N"), ("force-amplitude", "N"), ("moment-mean", "N m"), ("moment-amplitude", "N m")):
+        fl.add_argument(f"--{k}", type=float, nargs=3, default=[0.0, 0.0, 0.0], metavar=("X", "Y", "Z"),
+                        help=f"{k.replace('-', ' ')}, {unit} (default 0 0 0)")
+    fl.add_argument("--period", type=float, default=60.0, help="period, s (default 60)")
     w.add_argument("sweep", help="sweep TOML file ([simulation] + [sweep])")
     w.add_argument("--out", help="result store (a folder; default: <sweep name>.store)")
     w.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://host:8786")
@@ -487,6 +512,36 @@ def _plot(args) -> int:
     return 0
 
 
+def _fmu(args) -> int:
+    import phsplit
+    from . import fmu
+
+    if args.fmu_command is None:
+        raise UsageError("fmu needs a command: 'export' or 'load' (see 'phsplit fmu --help')")
+    try:
+        if args.fmu_command == "export":
+            extra = {}
+            for b in args.binary:
+                plat, sep, path = b.partition("=")
+                if not sep or not plat or not path:
+                    raise UsageError(f"--binary takes PLATFORM=PATH (e.g. win64=phsplit_fmu.dll), got {b!r}")
+                extra[plat] = path
+            out = fmu.export(args.scenario, args.out, binaries=extra)
+        else:
+            out = fmu.export_load(args.out, force_mean=args.force_mean, force_amplitude=args.force_amplitude,
+                                  moment_mean=args.moment_mean, moment_amplitude=args.moment_amplitude,
+                                  period=args.period)
+    except phsplit.PhsplitError as e:
+        if isinstance(e, (phsplit.InvalidInputError, phsplit.ScenarioParseError)):
+            raise
+        print(f"phsplit: error: {e}", file=sys.stderr)
+        return 1
+    except OSError as e:
+        raise UsageError(f"cannot write {args.out!r}: {e.strerror}") from None
+    print(f"wrote {os.path.abspath(out)}")
+    return 0
+
+
 def _methods() -> int:
     import phsplit
 
@@ -534,6 +589,8 @@ def main(argv: list[str] | None = None) -> int:
             return _rerun(args)
         if args.command == "plot":
             return _plot(args)
+        if args.command == "fmu":
+            return _fmu(args)
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

@@ -1,0 +1,915 @@
+//! The FMU's model, independent of the C interface: its variables (one table, read by the
+//! exporter to write `modelDescription.xml` and by the FMU to serve `fmi2Get*`/`fmi2Set*`), and
+//! an instance that steps the vessel between communication points (docs/fmu.md).
+//!
+//! Two kinds of FMU come from this binary, chosen by the resource file `fmu.toml`:
+//! - `vessel`: a phsplit vessel (any vessel file) integrated by one of phsplit's methods at an
+//!   internal step, with the external load, the set point and the current as inputs;
+//! - `load`: a periodic load source, `f(t) = f̄ + f̂ sin(2π t / T)` per component (a slowly
+//!   varying pipe tension or wind load), the second FMU of the co-simulation examples.
+
+use nalgebra::Vector3;
+use phsplit_core::lie::so3;
+use phsplit_core::model::vessel::{Vessel, VesselState, VesselSystem};
+use phsplit_core::settings::Settings;
+use phsplit_core::solve::{run, AccountKind, Options, Status};
+use std::sync::Arc;
+use toml::{Table, Value};
+
+/// An error with the message the FMU logs.
+pub type Result<T> = std::result::Result<T, String>;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Type {
+    Real,
+    Boolean,
+    String,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    Input,
+    Output,
+}
+
+/// A value of a variable.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Val {
+    Real(f64),
+    Boolean(bool),
+    String(String),
+}
+
+/// What a variable is in the model.
+#[derive(Debug, Clone, PartialEq)]
+enum Role {
+    /// A number of the vessel file: `[table] key` or its element `index`.
+    VesselNumber {
+        table: String,
+        key: String,
+        index: Option<usize>,
+    },
+    /// A run setting (`method`, `h`, …) or an FMU option (`external_frame`, `control`).
+    Setting(&'static str),
+    /// A component of a named group of inputs (`external_force`, …) or of a load's parameters.
+    Group(&'static str, usize),
+    /// An output: its group and component (or the account index of `ledger.*`).
+    Output(&'static str, usize),
+}
+
+/// One scalar variable of the FMU.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variable {
+    pub name: String,
+    /// Its value reference (its index in the table).
+    pub vr: u32,
+    pub ty: Type,
+    pub causality: Causality,
+    /// The start value (parameters and inputs; outputs have none).
+    pub start: Option<Val>,
+    pub unit: &'static str,
+    pub description: String,
+    role: Role,
+}
+
+/// The FMU kinds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    Vessel,
+    Load,
+}
+
+/// The variables of an FMU and what it was built from.
+#[derive(Debug, Clone)]
+pub struct Layout {
+    pub kind: Kind,
+    pub vars: Vec<Variable>,
+    /// The vessel file as the FMU runs it (normalised, with the `[external]` and `[current]`
+    /// tables that carry the inputs).
+    base: Table,
+    /// The ledger accounts of the vessel.
+    accounts: Vec<(&'static str, AccountKind)>,
+}
+
+/// Axis names of the spatial / body components.
+const XYZ: [&str; 3] = ["x", "y", "z"];
+
+/// The largest 1-D array of the vessel file whose elements become parameters (longer arrays,
+/// tables of coefficients, stay as the resource file gives them).
+const MAX_PARAMETER_ARRAY: usize = 6;
+
+/// Keys of the vessel file that inputs set, so they are not parameters too.
+fn driven_by_input(table: &str, key: &str, index: Option<usize>, setpoint_inputs: bool) -> bool {
+    match (table, key) {
+        ("external", "force" | "moment") => true,
+        ("current", "velocity") => index.is_some_and(|i| i < 2),
+        ("control", "position_reference") => setpoint_inputs && index.is_some_and(|i| i < 2),
+        ("control", "euler_reference") => setpoint_inputs && index == Some(2),
+        _ => false,
+    }
+}
+
+struct Builder {
+    vars: Vec<Variable>,
+}
+
+impl Builder {
+    #[allow(clippy::too_many_arguments)]
+    fn push(
+        &mut self,
+        name: String,
+        ty: Type,
+        causality: Causality,
+        start: Option<Val>,
+        unit: &'static str,
+        description: String,
+        role: Role,
+    ) {
+        let vr = self.vars.len() as u32;
+        self.vars.push(Variable {
+            name,
+            vr,
+            ty,
+            causality,
+            start,
+            unit,
+            description,
+            role,
+        });
+    }
+    fn output(&mut self, group: &'static str, names: &[&str], unit: &'static str, what: &str) {
+        for (i, n) in names.iter().enumerate() {
+            self.push(
+                format!("{group}.{n}"),
+                Type::Real,
+                Causality::Output,
+                None,
+                unit,
+                format!("{what} ({n})"),
+                Role::Output(group, i),
+            );
+        }
+    }
+    fn input(&mut self, group: &'static str, starts: &[(&str, f64, &'static str)], what: &str) {
+        for (i, (n, v, unit)) in starts.iter().enumerate() {
+            self.push(
+                format!("{group}.{n}"),
+                Type::Real,
+                Causality::Input,
+                Some(Val::Real(*v)),
+                unit,
+                format!("{what} ({n})"),
+                Role::Group(group, i),
+            );
+        }
+    }
+    fn setting(&mut self, name: &'static str, start: Val, unit: &'static str, what: &str) {
+        let ty = match start {
+            Val::Real(_) => Type::Real,
+            Val::Boolean(_) => Type::Boolean,
+            Val::String(_) => Type::String,
+        };
+        self.push(
+            name.to_string(),
+            ty,
+            Causality::Parameter,
+            Some(start),
+            unit,
+            what.to_string(),
+            Role::Setting(name),
+        );
+    }
+}
+
+/// The 3-vector `key` of the table `t` (zeros where absent).
+fn vec3_in(t: &Table, key: &str) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    if let Some(Value::Array(a)) = t.get(key) {
+        for (o, v) in out.iter_mut().zip(a) {
+            *o = float(v).unwrap_or(0.0);
+        }
+    }
+    out
+}
+
+/// The 3-vector `[table] key` of a vessel file (zeros where absent).
+fn vec3_of(t: &Table, table: &str, key: &str) -> [f64; 3] {
+    t.get(table)
+        .and_then(|v| v.as_table())
+        .map_or([0.0; 3], |s| vec3_in(s, key))
+}
+
+fn float(v: &Value) -> Option<f64> {
+    v.as_float().or_else(|| v.as_integer().map(|i| i as f64))
+}
+
+impl Layout {
+    /// The layout of an FMU from its resource files: `fmu` (the `fmu.toml` text: `[fmu] kind`,
+    /// `[simulation]` for a vessel, `[load]` for a load) and, for a vessel, the vessel file.
+    pub fn new(fmu: &str, vessel: Option<&str>) -> Result<Self> {
+        let fmu: Table = fmu
+            .parse()
+            .map_err(|e| format!("resources/fmu.toml cannot be read: {e}"))?;
+        let kind = fmu
+            .get("fmu")
+            .and_then(|t| t.get("kind"))
+            .and_then(|v| v.as_str())
+            .unwrap_or("vessel");
+        match kind {
+            "vessel" => {
+                let text = vessel.ok_or("a vessel FMU needs resources/vessel.toml")?;
+                let sim = fmu
+                    .get("simulation")
+                    .and_then(|v| v.as_table())
+                    .cloned()
+                    .unwrap_or_default();
+                Self::vessel(text, &sim)
+            }
+            "load" => Ok(Self::load(
+                fmu.get("load")
+                    .and_then(|v| v.as_table())
+                    .cloned()
+                    .unwrap_or_default(),
+            )),
+            other => Err(format!(
+                "resources/fmu.toml: [fmu] kind must be 'vessel' or 'load', got {other:?}"
+            )),
+        }
+    }
+
+    /// A vessel FMU of the vessel file `text` with the run settings `sim` (a `[simulation]`
+    /// table: method, h, control_start, linear_flow, outer, project_invariants).
+    pub fn vessel(text: &str, sim: &Table) -> Result<Self> {
+        let mut table: Table = text
+            .parse()
+            .map_err(|e| format!("the vessel file cannot be read: {e}"))?;
+        // The tables the inputs act through; present (with zero loads) in every vessel FMU, so
+        // that the ledger has the same accounts whatever the inputs.
+        let ext = table
+            .entry("external")
+            .or_insert_with(|| Value::Table(Table::new()));
+        if let Value::Table(e) = ext {
+            for k in ["force", "moment", "point"] {
+                e.entry(k)
+                    .or_insert_with(|| Value::Array(vec![Value::Float(0.0); 3]));
+            }
+            e.entry("frame")
+                .or_insert_with(|| Value::String("body".into()));
+        }
+        let has_current_table = table.get("current").and_then(|c| c.get("times")).is_some();
+        if !has_current_table {
+            let c = table
+                .entry("current")
+                .or_insert_with(|| Value::Table(Table::new()));
+            if let Value::Table(c) = c {
+                c.entry("velocity")
+                    .or_insert_with(|| Value::Array(vec![Value::Float(0.0); 3]));
+            }
+        }
+        let vessel = Vessel::from_table(table).map_err(|e| e.to_string())?;
+        let base = vessel.params.clone();
+        let (settings, _) = Settings::from_table(sim).map_err(|e| e.to_string())?;
+        let sys = VesselSystem::new(&vessel, Some(0.0));
+        use phsplit_core::solve::Model;
+        let accounts: Vec<_> = sys.accounts().iter().map(|a| (a.name, a.kind)).collect();
+        let setpoint_inputs = base.contains_key("control") && !base.contains_key("setpoint");
+
+        let mut b = Builder { vars: Vec::new() };
+        // Outputs.
+        b.output(
+            "position",
+            &XYZ,
+            "m",
+            "position of the body origin, spatial frame (z up)",
+        );
+        b.output(
+            "euler",
+            &["roll", "pitch", "yaw"],
+            "rad",
+            "ZYX Euler angles of the attitude",
+        );
+        b.output(
+            "quaternion",
+            &["w", "x", "y", "z"],
+            "1",
+            "unit quaternion of the attitude, body to spatial, scalar first",
+        );
+        b.output(
+            "velocity",
+            &["u", "v", "w"],
+            "m/s",
+            "linear velocity, body frame",
+        );
+        b.output(
+            "angular_velocity",
+            &["p", "q", "r"],
+            "rad/s",
+            "angular velocity, body frame",
+        );
+        b.output(
+            "control_force",
+            &XYZ,
+            "N",
+            "force of the controller (or what its thrusters deliver), body frame",
+        );
+        b.output(
+            "control_moment",
+            &XYZ,
+            "N.m",
+            "moment of the controller (or its thrusters) about the body origin, body frame",
+        );
+        b.output(
+            "energy",
+            &["stored", "supplied", "dissipated"],
+            "J",
+            "stored energy H; energy supplied through the ports and dissipated since the start",
+        );
+        let names: Vec<&str> = accounts.iter().map(|a| a.0).collect();
+        b.output(
+            "ledger",
+            &names,
+            "J",
+            "energy booked by the account since the start (supplied or dissipated, as its kind)",
+        );
+        // Inputs.
+        let f = vec3_of(&base, "external", "force");
+        let m = vec3_of(&base, "external", "moment");
+        b.input(
+            "external_force",
+            &[("x", f[0], "N"), ("y", f[1], "N"), ("z", f[2], "N")],
+            "external force at external.point, in the frame external_frame",
+        );
+        b.input(
+            "external_moment",
+            &[("x", m[0], "N.m"), ("y", m[1], "N.m"), ("z", m[2], "N.m")],
+            "external moment, in the frame external_frame",
+        );
+        if setpoint_inputs {
+            let xr = vec3_of(&base, "control", "position_reference");
+            let er = vec3_of(&base, "control", "euler_reference");
+            b.input(
+                "setpoint",
+                &[
+                    ("x", xr[0], "m"),
+                    ("y", xr[1], "m"),
+                    ("heading", er[2], "rad"),
+                ],
+                "the controller's set point: position (spatial frame) and heading (yaw)",
+            );
+        }
+        if !has_current_table {
+            let c = vec3_of(&base, "current", "velocity");
+            b.input(
+                "current",
+                &[("x", c[0], "m/s"), ("y", c[1], "m/s")],
+                "uniform current velocity, spatial frame (the direction the water flows towards)",
+            );
+        }
+        // Run settings.
+        let s = &settings;
+        b.setting(
+            "method",
+            Val::String(s.method.name().into()),
+            "",
+            "integration method (phsplit methods: sp2, sp4, sp6, rk4, ...)",
+        );
+        b.setting("h", Val::Real(s.h), "s", "internal step; a communication step that is not a multiple of it ends with a shorter step");
+        b.setting(
+            "linear_flow",
+            Val::String(s.linear_flow.name().into()),
+            "",
+            "flow S2: 'exact' or 'gauss'",
+        );
+        b.setting(
+            "outer",
+            Val::String(s.outer.name().into()),
+            "",
+            "outermost flow of a composition: 'dissipative' or 'conservative'",
+        );
+        b.setting(
+            "control",
+            Val::Boolean(s.control_start.is_some()),
+            "",
+            "whether the controller acts",
+        );
+        b.setting(
+            "control_start",
+            Val::Real(s.control_start.unwrap_or(0.0)),
+            "s",
+            "the controller acts on internal steps that start at or after this time",
+        );
+        b.setting(
+            "project_invariants",
+            Val::Boolean(s.project_invariants),
+            "",
+            "project onto the restoring invariant after every internal step (energy-neutral)",
+        );
+        let frame = base
+            .get("external")
+            .and_then(|e| e.get("frame"))
+            .and_then(|v| v.as_str())
+            .unwrap_or("body")
+            .to_string();
+        b.setting("external_frame", Val::String(frame), "", "frame of the external force and moment inputs: 'body', 'spatial' (z up) or 'ned' (north-east-down, with the spatial frame read as north-west-up)");
+        // The vessel file's numbers as parameters.
+        for (tname, t) in &base {
+            let Some(t) = t.as_table() else { continue };
+            for (key, v) in t {
+                if tname == "external" && key == "frame" {
+                    continue;
+                }
+                match v {
+                    Value::Float(_) => {
+                        b.push(
+                            format!("{tname}.{key}"),
+                            Type::Real,
+                            Causality::Parameter,
+                            Some(Val::Real(float(v).unwrap())),
+                            "",
+                            format!("vessel file [{tname}] {key}"),
+                            Role::VesselNumber {
+                                table: tname.clone(),
+                                key: key.clone(),
+                                index: None,
+                            },
+                        );
+                    }
+                    Value::Array(a)
+                        if !a.is_empty()
+                            && a.len() <= MAX_PARAMETER_ARRAY
+                            && a.iter().all(|x| x.is_float()) =>
+                    {
+                        for (i, x) in a.iter().enumerate() {
+                            if driven_by_input(tname, key, Some(i), setpoint_inputs) {
+                                continue;
+                            }
+                            b.push(
+                                format!("{tname}.{key}[{i}]"),
+                                Type::Real,
+                                Causality::Parameter,
+                                Some(Val::Real(float(x).unwrap())),
+                                "",
+                                format!("vessel file [{tname}] {key}[{i}] (0-based)"),
+                                Role::VesselNumber {
+                                    table: tname.clone(),
+                                    key: key.clone(),
+                                    index: Some(i),
+                                },
+                            );
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        Ok(Self {
+            kind: Kind::Vessel,
+            vars: b.vars,
+            base,
+            accounts,
+        })
+    }
+
+    /// A periodic load source: parameters `force_mean.*`, `force_amplitude.*`,
+    /// `moment_mean.*`, `moment_amplitude.*` (start values from the `[load]` table's 3-vectors of
+    /// the same names) and `period` (s); outputs `force.*`, `moment.*`.
+    pub fn load(t: Table) -> Self {
+        let mut b = Builder { vars: Vec::new() };
+        b.output("force", &XYZ, "N", "load force");
+        b.output("moment", &XYZ, "N.m", "load moment");
+        for (name, unit) in [
+            ("force_mean", "N"),
+            ("force_amplitude", "N"),
+            ("moment_mean", "N.m"),
+            ("moment_amplitude", "N.m"),
+        ] {
+            let v = vec3_in(&t, name);
+            for (i, n) in XYZ.iter().enumerate() {
+                b.push(
+                    format!("{name}.{n}"),
+                    Type::Real,
+                    Causality::Parameter,
+                    Some(Val::Real(v[i])),
+                    unit,
+                    format!("{name} ({n})"),
+                    Role::Group(name, i),
+                );
+            }
+        }
+        let period = t.get("period").and_then(float).unwrap_or(60.0);
+        b.setting(
+            "period",
+            Val::Real(period),
+            "s",
+            "period of the load's oscillation",
+        );
+        Self {
+            kind: Kind::Load,
+            vars: b.vars,
+            base: Table::new(),
+            accounts: Vec::new(),
+        }
+    }
+
+    fn index_of(&self, role: &Role) -> Option<usize> {
+        self.vars.iter().position(|v| &v.role == role)
+    }
+}
+
+/// The vessel being stepped.
+#[derive(Debug, Clone)]
+struct Running {
+    vessel: Arc<Vessel>,
+    /// The inputs the vessel was built with.
+    inputs: Vec<f64>,
+    settings: Settings,
+    state: VesselState,
+    /// Energy booked per account, supplied and dissipated since the start (J).
+    booked: Vec<f64>,
+    supplied: f64,
+    dissipated: f64,
+}
+
+/// An FMU instance: the current values of the parameters and inputs, the time, and (after
+/// initialisation) the vessel's state. `Clone` is the FMU state of `fmi2GetFMUstate`.
+#[derive(Debug, Clone)]
+pub struct Instance {
+    pub layout: Arc<Layout>,
+    values: Vec<Option<Val>>,
+    pub time: f64,
+    running: Option<Running>,
+}
+
+/// How far a communication point may be from the instance's time (relative).
+const TIME_TOLERANCE: f64 = 1e-9;
+
+impl Instance {
+    pub fn new(layout: Arc<Layout>) -> Self {
+        let values = layout.vars.iter().map(|v| v.start.clone()).collect();
+        Self {
+            layout,
+            values,
+            time: 0.0,
+            running: None,
+        }
+    }
+
+    fn var(&self, vr: u32, ty: Type) -> Result<&Variable> {
+        let v = self.layout.vars.get(vr as usize).ok_or_else(|| {
+            format!(
+                "no variable has value reference {vr} (this FMU has {})",
+                self.layout.vars.len()
+            )
+        })?;
+        if v.ty != ty {
+            return Err(format!(
+                "variable {} (value reference {vr}) is of type {:?}, not {ty:?}",
+                v.name, v.ty
+            ));
+        }
+        Ok(v)
+    }
+
+    /// Set a parameter or input. Parameters are fixed once initialised (`initialized`).
+    pub fn set(&mut self, vr: u32, val: Val, initialized: bool) -> Result<()> {
+        let ty = match val {
+            Val::Real(_) => Type::Real,
+            Val::Boolean(_) => Type::Boolean,
+            Val::String(_) => Type::String,
+        };
+        let v = self.var(vr, ty)?;
+        match v.causality {
+            Causality::Output => Err(format!("{} is an output and cannot be set", v.name)),
+            Causality::Parameter if initialized => Err(format!(
+                "{} is a fixed parameter and cannot be set after initialisation",
+                v.name
+            )),
+            _ => {
+                self.values[vr as usize] = Some(val);
+                Ok(())
+            }
+        }
+    }
+
+    fn real(&self, role: Role) -> f64 {
+        match self
+            .layout
+            .index_of(&role)
+            .and_then(|i| self.values[i].clone())
+        {
+            Some(Val::Real(x)) => x,
+            _ => 0.0,
+        }
+    }
+
+    fn setting(&self, name: &'static str) -> Option<Val> {
+        self.layout
+            .index_of(&Role::Setting(name))
+            .and_then(|i| self.values[i].clone())
+    }
+
+    /// The current values of the inputs, in table order.
+    fn inputs(&self) -> Vec<f64> {
+        self.layout
+            .vars
+            .iter()
+            .zip(&self.values)
+            .filter(|(v, _)| v.causality == Causality::Input)
+            .map(|(_, x)| match x {
+                Some(Val::Real(r)) => *r,
+                _ => 0.0,
+            })
+            .collect()
+    }
+
+    /// The vessel file with the parameters and inputs applied.
+    fn vessel_table(&self) -> Result<Table> {
+        let mut t = self.layout.base.clone();
+        for (v, val) in self.layout.vars.iter().zip(&self.values) {
+            if let (Role::VesselNumber { table, key, index }, Some(Val::Real(x))) = (&v.role, val) {
+                let slot = t
+                    .get_mut(table)
+                    .and_then(|s| s.as_table_mut())
+                    .and_then(|s| s.get_mut(key))
+                    .ok_or_else(|| format!("internal: {table}.{key} missing"))?;
+                match (index, slot) {
+                    (None, slot) => *slot = Value::Float(*x),
+                    (Some(i), Value::Array(a)) => a[*i] = Value::Float(*x),
+                    _ => return Err(format!("internal: {table}.{key} is not an array")),
+                }
+            }
+        }
+        let get = |g: &'static str, i: usize| self.real(Role::Group(g, i));
+        let frame = match self.setting("external_frame") {
+            Some(Val::String(s)) => s,
+            _ => "body".into(),
+        };
+        let (mut f, mut m) = (
+            Vector3::from_fn(|i, _| get("external_force", i)),
+            Vector3::from_fn(|i, _| get("external_moment", i)),
+        );
+        let frame = match frame.as_str() {
+            "body" | "spatial" => frame,
+            "ned" => {
+                // NED (north, east, down) from the spatial frame read as north-west-up: a
+                // half-turn about north, a rotation, so force and moment transform alike.
+                f = Vector3::new(f.x, -f.y, -f.z);
+                m = Vector3::new(m.x, -m.y, -m.z);
+                "spatial".into()
+            }
+            other => {
+                return Err(format!(
+                    "external_frame must be 'body', 'spatial' or 'ned', got {other:?}"
+                ))
+            }
+        };
+        let arr = |v: Vector3<f64>| Value::Array(v.iter().map(|x| Value::Float(*x)).collect());
+        if let Some(Value::Table(e)) = t.get_mut("external") {
+            e.insert("force".into(), arr(f));
+            e.insert("moment".into(), arr(m));
+            e.insert("frame".into(), Value::String(frame));
+        }
+        if self.layout.index_of(&Role::Group("setpoint", 0)).is_some() {
+            if let Some(Value::Table(c)) = t.get_mut("control") {
+                for (key, i, g) in [
+                    ("position_reference", 0, 0),
+                    ("position_reference", 1, 1),
+                    ("euler_reference", 2, 2),
+                ] {
+                    if let Some(Value::Array(a)) = c.get_mut(key) {
+                        a[i] = Value::Float(get("setpoint", g));
+                    }
+                }
+            }
+        }
+        if self.layout.index_of(&Role::Group("current", 0)).is_some() {
+            if let Some(Value::Table(c)) = t.get_mut("current") {
+                if let Some(Value::Array(a)) = c.get_mut("velocity") {
+                    a[0] = Value::Float(get("current", 0));
+                    a[1] = Value::Float(get("current", 1));
+                }
+            }
+        }
+        Ok(t)
+    }
+
+    /// The run settings from the parameters, validated by the core.
+    fn settings(&self) -> Result<Settings> {
+        let mut t = Table::new();
+        for name in ["method", "linear_flow", "outer"] {
+            if let Some(Val::String(s)) = self.setting(name) {
+                t.insert(name.into(), Value::String(s));
+            }
+        }
+        if let Some(Val::Real(h)) = self.setting("h") {
+            t.insert("h".into(), Value::Float(h));
+            // Any span the step can resolve: only the step and the method matter here.
+            t.insert(
+                "t_span".into(),
+                Value::Array(vec![Value::Float(0.0), Value::Float(h.abs().max(1.0))]),
+            );
+        }
+        let on = !matches!(self.setting("control"), Some(Val::Boolean(false)));
+        match (on, self.setting("control_start")) {
+            (true, Some(Val::Real(tc))) => t.insert("control_start".into(), Value::Float(tc)),
+            _ => t.insert("control_start".into(), Value::String("never".into())),
+        };
+        if let Some(Val::Boolean(p)) = self.setting("project_invariants") {
+            t.insert("project_invariants".into(), Value::Boolean(p));
+        }
+        let (s, _) =
+            Settings::from_table(&t).map_err(|e| e.to_string().replacen("simulation.", "", 1))?;
+        s.validate()
+            .map_err(|e| e.to_string().replacen("simulation.", "", 1))?;
+        Ok(s)
+    }
+
+    fn build_vessel(&self) -> Result<Vessel> {
+        Vessel::from_table(self.vessel_table()?).map_err(|e| e.to_string())
+    }
+
+    /// Leave initialisation: build and check the vessel and the settings from the parameters,
+    /// and start from the vessel file's `[initial]` state at `t0`.
+    pub fn initialize(&mut self, t0: f64) -> Result<()> {
+        self.time = t0;
+        if self.layout.kind == Kind::Load {
+            let period = self.real(Role::Setting("period"));
+            if !(period.is_finite() && period > 0.0) {
+                return Err(format!("period must be finite and > 0 (s), got {period}"));
+            }
+            return Ok(());
+        }
+        let settings = self.settings()?;
+        let vessel = self.build_vessel()?;
+        let state = vessel.initial_state();
+        let n = VesselSystem::new(&vessel, None).accounts_len();
+        self.running = Some(Running {
+            vessel: Arc::new(vessel),
+            inputs: self.inputs(),
+            settings,
+            state,
+            booked: vec![0.0; n],
+            supplied: 0.0,
+            dissipated: 0.0,
+        });
+        Ok(())
+    }
+
+    /// Advance from the communication point `t` by `dt`: whole internal steps of `h` and, when
+    /// `dt` is not a multiple of `h`, a last shorter one.
+    pub fn step(&mut self, t: f64, dt: f64) -> Result<()> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(format!(
+                "the communication step must be finite and > 0, got {dt}"
+            ));
+        }
+        if (t - self.time).abs() > TIME_TOLERANCE * self.time.abs().max(1.0) {
+            return Err(format!(
+                "the communication point {t} is not where the FMU is ({}); set an FMU state to go back",
+                self.time
+            ));
+        }
+        if self.layout.kind == Kind::Load {
+            self.time = t + dt;
+            return Ok(());
+        }
+        let inputs = self.inputs();
+        let rebuilt = match &self.running {
+            Some(r) if r.inputs != inputs => Some(Arc::new(self.build_vessel()?)),
+            Some(_) => None,
+            None => return Err("the FMU is not initialised".into()),
+        };
+        let r = self.running.as_mut().expect("checked");
+        if let Some(v) = rebuilt {
+            r.vessel = v;
+            r.inputs = inputs;
+        }
+        let h = r.settings.h;
+        let ratio = dt / h;
+        let whole = ratio.round();
+        let (n_steps, last_h) = if whole >= 1.0 && (ratio - whole).abs() <= 1e-9 * ratio {
+            (whole as usize, h)
+        } else if ratio < 1.0 {
+            (1, dt)
+        } else {
+            let n = ratio.floor();
+            (n as usize + 1, dt - n * h)
+        };
+        let h_run = if n_steps == 1 { last_h } else { h };
+        let opts = Options {
+            t0: t,
+            h: h_run,
+            n_steps,
+            last_h,
+            save_every: n_steps,
+            outer: r.settings.outer,
+            ledger: true,
+        };
+        let sys = VesselSystem::new(&r.vessel, r.settings.control_start)
+            .with_linear_flow(r.settings.linear_flow)
+            .with_projection(r.settings.project_invariants);
+        let traj = run(&sys, &r.settings.method, r.state, &opts).map_err(|e| e.to_string())?;
+        if let Status::Failed { t, reason, .. } = &traj.status {
+            return Err(format!("the vessel's state became non-finite in the step from t = {t} s ({reason}); the step is too long for this method or the inputs are extreme"));
+        }
+        let last = traj.states.len() - 1;
+        r.state = traj.states[last];
+        // Booked per saved interval (the first is zero): here the whole communication step.
+        for w in &traj.booked {
+            for (acc, x) in r.booked.iter_mut().zip(w.0.iter()) {
+                *acc += x;
+            }
+        }
+        r.supplied += traj.supplied.iter().sum::<f64>();
+        r.dissipated += traj.dissipated.iter().sum::<f64>();
+        self.time = t + dt;
+        Ok(())
+    }
+
+    /// The value of a Real variable (parameters and inputs as set; outputs at the current
+    /// state and time).
+    pub fn get_real(&self, vr: u32) -> Result<f64> {
+        let v = self.var(vr, Type::Real)?;
+        match &v.role {
+            Role::Output(group, i) => self.output(group, *i),
+            _ => match &self.values[vr as usize] {
+                Some(Val::Real(x)) => Ok(*x),
+                _ => Err(format!("{} has no value", v.name)),
+            },
+        }
+    }
+
+    pub fn get_boolean(&self, vr: u32) -> Result<bool> {
+        let v = self.var(vr, Type::Boolean)?;
+        match &self.values[vr as usize] {
+            Some(Val::Boolean(x)) => Ok(*x),
+            _ => Err(format!("{} has no value", v.name)),
+        }
+    }
+
+    pub fn get_string(&self, vr: u32) -> Result<String> {
+        let v = self.var(vr, Type::String)?;
+        match &self.values[vr as usize] {
+            Some(Val::String(x)) => Ok(x.clone()),
+            _ => Err(format!("{} has no value", v.name)),
+        }
+    }
+
+    fn output(&self, group: &str, i: usize) -> Result<f64> {
+        if self.layout.kind == Kind::Load {
+            let t = self.time;
+            let period = self.real(Role::Setting("period"));
+            let s = (2.0 * std::f64::consts::PI * t / period).sin();
+            let (mean, amp) = match group {
+                "force" => ("force_mean", "force_amplitude"),
+                _ => ("moment_mean", "moment_amplitude"),
+            };
+            return Ok(self.real(Role::Group(mean, i)) + self.real(Role::Group(amp, i)) * s);
+        }
+        let r = self
+            .running
+            .as_ref()
+            .ok_or("outputs are defined once the FMU is initialised")?;
+        let s = &r.state;
+        let body = &r.vessel.body;
+        Ok(match group {
+            "position" => s.x[i],
+            "euler" => s.euler()[i],
+            "quaternion" => so3::quaternion(&s.q)[i],
+            "velocity" => s.p[i] / body.mass,
+            "angular_velocity" => s.m[i] * body.inertia_inv[i],
+            "control_force" | "control_moment" => {
+                let sys = VesselSystem::new(&r.vessel, r.settings.control_start);
+                let on = sys.control_on(self.time);
+                let w = sys.account_wrenches(s, self.time, on);
+                let mut total = Vector3::zeros();
+                for ((name, _), (f, m)) in self.layout.accounts.iter().zip(&w) {
+                    if matches!(*name, "control" | "control_damping" | "thrusters") {
+                        total += if group == "control_force" { f } else { m };
+                    }
+                }
+                total[i]
+            }
+            "energy" => match i {
+                0 => r.vessel.energy(s),
+                1 => r.supplied,
+                _ => r.dissipated,
+            },
+            "ledger" => r.booked[i],
+            other => return Err(format!("internal: unknown output group {other}")),
+        })
+    }
+}
+
+/// The number of ledger accounts of a system.
+trait AccountsLen {
+    fn accounts_len(&self) -> usize;
+}
+
+impl AccountsLen for VesselSystem<'_> {
+    fn accounts_len(&self) -> usize {
+        use phsplit_core::solve::Model;
+        self.accounts().len()
+    }
+}

@@ -1,0 +1,269 @@
+"""A phsplit vessel as an FMI 2.0 co-simulation FMU, for FMPy, OSP's libcosim and every FMI host
+(issue 15; docs/fmu.md).
+
+:func:`export` writes ``vessel.fmu``: ``modelDescription.xml``, the binary built from the Rust core
+(``binaries/linux64/phsplit_fmu.so``, no Python inside) and the vessel and settings as resources.
+The variable table comes from the same Rust code the binary serves (``phsplit-fmu``), so the two
+cannot disagree. :func:`export_load` writes a second, small FMU from the same binary: a periodic
+load source (a slowly varying pipe tension or wind load) to couple with a vessel.
+
+Energy statement: the FMU integrates the vessel with the chosen method between communication
+points, with the inputs held constant over each communication step (a zero-order hold, as every
+co-simulation master gives them). Over one communication step the split keeps its guarantee
+(exact passivity for positive-coefficient methods, Prop. 2.5's condition otherwise) with respect
+to the constant inputs, and the outputs ``ledger.*`` book each port's work exactly as
+:func:`phsplit.simulate` does. The coupling itself (what the master does between steps) is outside
+the FMU and can create energy; the ledger shows what came in through ``external``.
+"""
+from __future__ import annotations
+
+import hashlib
+import io
+import os
+import platform
+import sys
+import tempfile
+import uuid
+import xml.etree.ElementTree as ET
+import zipfile
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+from . import _core
+
+#: The model identifier: the binary's file name in ``binaries/<platform>/``.
+MODEL_IDENTIFIER = "phsplit_fmu"
+
+#: Where the package keeps the binaries it ships (built by ``make build``).
+BINARIES = Path(__file__).parent / "_fmu" / "binaries"
+
+#: Units of the variables, as SI base-unit exponents (FMI 2.0 ``UnitDefinitions``).
+_UNITS = {
+    "m": {"m": 1}, "rad": {"rad": 1}, "1": {}, "s": {"s": 1},
+    "m/s": {"m": 1, "s": -1}, "rad/s": {"rad": 1, "s": -1},
+    "N": {"kg": 1, "m": 1, "s": -2}, "N.m": {"kg": 1, "m": 2, "s": -2},
+    "J": {"kg": 1, "m": 2, "s": -2},
+}
+
+
+def _host_platform() -> str:
+    """The FMI platform folder of this machine (linux64, win64, darwin64)."""
+    bits = "64" if sys.maxsize > 2**32 else "32"
+    system = {"linux": "linux", "win32": "win", "darwin": "darwin"}.get(sys.platform, sys.platform)
+    return f"{system}{bits}"
+
+
+def _binary_name(plat: str) -> str:
+    ext = ".dll" if plat.startswith("win") else ".dylib" if plat.startswith("darwin") else ".so"
+    return MODEL_IDENTIFIER + ext
+
+
+def _binaries(extra: Mapping[str, str | os.PathLike[str]] | None) -> dict[str, bytes]:
+    """The binaries to pack: the shipped one for this machine, plus ``extra`` (platform -> path)."""
+    out: dict[str, bytes] = {}
+    plat = _host_platform()
+    shipped = BINARIES / plat / _binary_name(plat)
+    if shipped.exists():
+        out[plat] = shipped.read_bytes()
+    for p, path in (extra or {}).items():
+        if p not in ("linux64", "linux32", "win64", "win32", "darwin64"):
+            raise _core.InvalidInputError(f"binary platform must be one of linux64, linux32, win64, win32, "
+                                          f"darwin64 (FMI 2.0 platform folders), got {p!r}")
+        try:
+            out[p] = Path(path).read_bytes()
+        except OSError as e:
+            raise _core.InvalidInputError(f"cannot read the {p} binary {os.fspath(path)!r}: {e.strerror}") from None
+    if not out:
+        raise _core.PhsplitError(
+            f"no FMU binary for this platform ({plat}, {platform.machine()}): the package ships "
+            f"{sorted(q.name for q in BINARIES.iterdir()) if BINARIES.exists() else 'none'}; build one with "
+            "'cargo build -p phsplit-fmu --release' and pass it as binaries={'<platform>': path} "
+            "(docs/fmu.md)")
+    return out
+
+
+def _toml(tables: Mapping[str, Any]) -> str:
+    return _core.dumps_toml(dict(tables))
+
+
+def _scalar_text(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return repr(v)
+    return str(v)
+
+
+def _model_description(name: str, description: str, variables: list[dict[str, Any]], guid: str,
+                       experiment: Mapping[str, float]) -> bytes:
+    root = ET.Element("fmiModelDescription", {
+        "fmiVersion": "2.0", "modelName": name, "guid": guid, "description": description,
+        "generationTool": f"phsplit {_core.__version__}", "variableNamingConvention": "flat",
+        "numberOfEventIndicators": "0",
+    })
+    ET.SubElement(root, "CoSimulation", {
+        "modelIdentifier": MODEL_IDENTIFIER, "needsExecutionTool": "false",
+        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
+        "maxOutputDerivativeOrder": "0", "canRunAsynchronuously": "false",
+        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
+        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "false",
+        "providesDirectionalDerivative": "false",
+    })
+    used = sorted({v["unit"] for v in variables if v["unit"]})
+    if used:
+        units = ET.SubElement(root, "UnitDefinitions")
+        for u in used:
+            el = ET.SubElement(units, "Unit", {"name": u})
+            ET.SubElement(el, "BaseUnit", {k: str(e) for k, e in _UNITS[u].items()})
+    ET.SubElement(root, "DefaultExperiment", {k: repr(float(v)) for k, v in experiment.items()})
+    mv = ET.SubElement(root, "ModelVariables")
+    outputs = []
+    for i, v in enumerate(variables, start=1):
+        attrs = {"name": v["name"], "valueReference": str(v["vr"]), "description": v["description"],
+                 "causality": v["causality"]}
+        if v["causality"] == "parameter":
+            attrs["variability"] = "fixed"
+            attrs["initial"] = "exact"
+        elif v["causality"] == "input":
+            attrs["variability"] = "continuous" if v["type"] == "Real" else "discrete"
+        else:
+            attrs["variability"] = "continuous"
+            attrs["initial"] = "calculated"
+            outputs.append(i)
+        sv = ET.SubElement(mv, "ScalarVariable", attrs)
+        tattrs = {}
+        if v["start"] is not None:
+            tattrs["start"] = _scalar_text(v["start"])
+        if v["unit"] and v["type"] == "Real":
+            tattrs["unit"] = v["unit"]
+        ET.SubElement(sv, v["type"], tattrs)
+    ms = ET.SubElement(root, "ModelStructure")
+    outs = ET.SubElement(ms, "Outputs")
+    for i in outputs:
+        ET.SubElement(outs, "Unknown", {"index": str(i)})
+    init = ET.SubElement(ms, "InitialUnknowns")
+    for i in outputs:
+        ET.SubElement(init, "Unknown", {"index": str(i)})
+    ET.indent(root)
+    return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
+
+
+def _write_fmu(out: str | os.PathLike[str], name: str, description: str, resources: dict[str, str],
+               experiment: Mapping[str, float], binaries: dict[str, bytes]) -> Path:
+    """Pack an FMU: a GUID from the content, entries in a fixed order with fixed dates (the same
+    inputs give the same bytes), written under a temporary name and renamed (no partial file)."""
+    variables = _core.fmu_variables(resources["fmu.toml"], resources.get("vessel.toml"))
+    digest = hashlib.sha256()
+    for k in sorted(resources):
+        digest.update(k.encode() + b"\0" + resources[k].encode() + b"\0")
+    for p in sorted(binaries):
+        digest.update(p.encode() + b"\0" + binaries[p] + b"\0")
+    guid = "{" + str(uuid.UUID(bytes=digest.digest()[:16], version=4)) + "}"
+    fmu_toml = resources["fmu.toml"].replace("[fmu]\n", f'[fmu]\nguid = "{guid}"\n', 1)
+    md = _model_description(name, description, variables, guid, experiment)
+    entries: list[tuple[str, bytes, int]] = [("modelDescription.xml", md, 0o644)]
+    for p in sorted(binaries):
+        entries.append((f"binaries/{p}/{_binary_name(p)}", binaries[p], 0o755))
+    entries.append(("resources/fmu.toml", fmu_toml.encode(), 0o644))
+    for k in sorted(resources):
+        if k != "fmu.toml":
+            entries.append((f"resources/{k}", resources[k].encode(), 0o644))
+    out = Path(out)
+    if out.suffix != ".fmu":
+        raise _core.InvalidInputError(f"the FMU file must end in .fmu, got {os.fspath(out)!r}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".tmp", dir=out.parent)
+    try:
+        with os.fdopen(fd, "wb") as f, zipfile.ZipFile(f, "w", zipfile.ZIP_DEFLATED) as z:
+            for arc, data, mode in entries:
+                info = zipfile.ZipInfo(arc, date_time=(1980, 1, 1, 0, 0, 0))
+                info.external_attr = (0o100000 | mode) << 16
+                info.compress_type = zipfile.ZIP_DEFLATED
+                z.writestr(info, data)
+        os.replace(tmp, out)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    return out
+
+
+def export(scenario: Any = None, out: str | os.PathLike[str] = "vessel.fmu", *,
+           binaries: Mapping[str, str | os.PathLike[str]] | None = None,
+           model_name: str | None = None) -> Path:
+    """Write a co-simulation FMU of a scenario's vessel and settings.
+
+    ``scenario``: a :class:`phsplit.scenario.Scenario`, a scenario file or shipped scenario name,
+    or None for the paper's Fig. 2 (the paper's vessel, SP4 at h = 0.5 s, the controller from
+    t = 50 s). The FMU's parameters start at the scenario's values: ``method``, ``h`` (the internal
+    step), ``linear_flow``, ``outer``, ``control``/``control_start``, ``project_invariants``,
+    ``external_frame``, and every number of the vessel file (``vessel.mass``,
+    ``initial.euler[0]``, …). Its inputs are the external force and moment, the set point
+    (position and heading) and the current; its outputs the position, Euler angles, quaternion,
+    body velocities, the controller's force and moment, the stored energy and the ledger by port.
+    ``binaries`` adds binaries built for other platforms (``{"win64": "phsplit_fmu.dll"}``).
+
+    >>> import phsplit.fmu, tempfile, os
+    >>> path = phsplit.fmu.export(None, os.path.join(tempfile.mkdtemp(), "fig2.fmu"))
+    >>> path.name
+    'fig2.fmu'
+    """
+    from . import scenario as sc
+
+    if scenario is None:
+        s = sc.Scenario.paper_fig2()
+    elif isinstance(scenario, sc.Scenario):
+        s = scenario
+    else:
+        s = sc.load(sc.resolve(scenario))
+    st = s.settings
+    sim = {"method": st.method, "h": float(st.h), "linear_flow": st.linear_flow, "outer": st.outer,
+           "project_invariants": bool(st.project_invariants),
+           "control_start": "never" if st.control_start is None else float(st.control_start)}
+    resources = {
+        "fmu.toml": "[fmu]\nkind = \"vessel\"\n\n" + _toml({"simulation": sim}),
+        "vessel.toml": s.vessel.to_toml(),
+    }
+    t0, t1 = st.t_span
+    name = model_name or f"phsplit vessel ({s.name})"
+    desc = (f"phsplit vessel '{s.name}' ({s.vessel.source or 'custom'}) integrated by passivity-preserving "
+            "splitting (Celledoni, Hoiseth, Ramzina 2018); inputs: external load, set point, current")
+    return _write_fmu(out, name, desc, resources, {"startTime": t0, "stopTime": t1, "stepSize": st.h},
+                      _binaries(binaries))
+
+
+def _vec3(name: str, v: Sequence[float]) -> list[float]:
+    try:
+        out = [float(x) for x in v]
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError(f"{name} must be 3 numbers, got {v!r}") from None
+    if len(out) != 3 or not all(x == x and abs(x) != float("inf") for x in out):
+        raise _core.InvalidInputError(f"{name} must be 3 finite numbers, got {v!r}")
+    return out
+
+
+def export_load(out: str | os.PathLike[str] = "load.fmu", *, force_mean: Sequence[float] = (0, 0, 0),
+                force_amplitude: Sequence[float] = (0, 0, 0), moment_mean: Sequence[float] = (0, 0, 0),
+                moment_amplitude: Sequence[float] = (0, 0, 0), period: float = 60.0,
+                binaries: Mapping[str, str | os.PathLike[str]] | None = None) -> Path:
+    """Write a periodic load source FMU: outputs ``force.x/y/z`` (N) and ``moment.x/y/z`` (N m),
+    ``mean + amplitude · sin(2π t / period)`` per component, at each communication point; the
+    means, amplitudes and period are its parameters. Connect its outputs to a vessel FMU's
+    ``external_force.*`` and ``external_moment.*`` (see docs/fmu.md for an OSP system structure).
+    """
+    load = {"force_mean": _vec3("force_mean", force_mean),
+            "force_amplitude": _vec3("force_amplitude", force_amplitude),
+            "moment_mean": _vec3("moment_mean", moment_mean),
+            "moment_amplitude": _vec3("moment_amplitude", moment_amplitude)}
+    try:
+        p = float(period)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError(f"period must be a number of seconds, got {period!r}") from None
+    if not (p > 0 and p != float("inf")):
+        raise _core.InvalidInputError(f"period must be finite and > 0 (s), got {period!r}")
+    load["period"] = p
+    resources = {"fmu.toml": "[fmu]\nkind = \"load\"\n\n" + _toml({"load": load})}
+    return _write_fmu(out, "phsplit periodic load", "a periodic force and moment: mean + amplitude sin(2 pi t / period)",
+                      resources, {"startTime": 0.0, "stepSize": 1.0}, _binaries(binaries))
