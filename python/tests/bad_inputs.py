@@ -322,3 +322,20 @@ CATALOGUE += [
     Bad("watch circle of negative radius", lambda: phsplit.events.watch_circle(-5.0), E, ("radius", "> 0")),
     Bad("open_dataset of a missing file", lambda: phsplit.open_dataset("/nonexistent/run.nc"), E, ("does not exist",)),
 ]
+
+CATALOGUE += [
+    # issue 15: the FMU exporter
+    Bad("CLI: FMU file without .fmu", cli("fmu", "export", "-o", "vessel.zip"), C, ("must end in .fmu",)),
+    Bad("CLI: FMU binary for an unknown platform", cli("fmu", "export", "-o", "v.fmu", "--binary", "beos=x.so"), C,
+        ("binary platform", "linux64", "win64")),
+    Bad("CLI: FMU binary without its platform", cli("fmu", "export", "-o", "v.fmu", "--binary", "x.so"), C,
+        ("--binary", "PLATFORM=PATH")),
+    Bad("CLI: FMU binary that does not exist", cli("fmu", "export", "-o", "v.fmu", "--binary", "win64=nowhere.dll"), C,
+        ("win64 binary", "nowhere.dll")),
+    Bad("CLI: fmu without a command", cli("fmu"), C, ("'export' or 'load'",)),
+    Bad("CLI: load FMU with a zero period", cli("fmu", "load", "-o", "l.fmu", "--period", "0"), C,
+        ("period", "> 0")),
+    Bad("load FMU with a 2-vector", lambda: __import__("phsplit.fmu").fmu.export_load("l.fmu", force_mean=[1, 2]), E,
+        ("force_mean", "3 finite numbers")),
+    Bad("FMU of a missing scenario", cli("fmu", "export", "nowhere.toml", "-o", "v.fmu"), C, ("nowhere.toml",)),
+]

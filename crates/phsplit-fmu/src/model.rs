@@ -913,3 +913,153 @@ impl AccountsLen for VesselSystem<'_> {
         self.accounts().len()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use phsplit_core::model::vessel::PAPER_VESSEL_TOML;
+
+    const FIG2: &str =
+        "[fmu]\nkind = \"vessel\"\n[simulation]\nmethod = \"sp4\"\nh = 0.5\ncontrol_start = 50.0\n";
+
+    fn fig2() -> Arc<Layout> {
+        Arc::new(Layout::new(FIG2, Some(PAPER_VESSEL_TOML)).unwrap())
+    }
+
+    fn vr(l: &Layout, name: &str) -> u32 {
+        l.vars.iter().find(|v| v.name == name).unwrap().vr
+    }
+
+    #[test]
+    fn the_table_is_consistent() {
+        let l = fig2();
+        let mut names = std::collections::HashSet::new();
+        for (i, v) in l.vars.iter().enumerate() {
+            assert_eq!(v.vr as usize, i);
+            assert!(names.insert(v.name.clone()), "duplicate {}", v.name);
+            assert_eq!(
+                v.start.is_none(),
+                v.causality == Causality::Output,
+                "{}",
+                v.name
+            );
+        }
+        // The inputs are not parameters too.
+        for n in [
+            "external.force[0]",
+            "control.position_reference[0]",
+            "current.velocity[1]",
+        ] {
+            assert!(!names.contains(n), "{n}");
+        }
+        assert!(names.contains("control.position_reference[2]"));
+        assert!(names.contains("ledger.external") && names.contains("ledger.current"));
+        // A moving set point (a [setpoint] table) takes the place of the set-point inputs.
+        let text = format!("{PAPER_VESSEL_TOML}\n[setpoint]\nnatural_frequency = 0.1\ntimes = [0.0]\npositions = [[780.0, 20.0, 0.0]]\nheadings = [0.0]\n");
+        let moving = Layout::new(FIG2, Some(&text)).unwrap();
+        assert!(!moving
+            .vars
+            .iter()
+            .any(|v| v.causality == Causality::Input && v.name.starts_with("setpoint.")));
+        assert!(moving
+            .vars
+            .iter()
+            .any(|v| v.name == "setpoint.natural_frequency"));
+    }
+
+    #[test]
+    fn bad_resources_are_named() {
+        let e = Layout::new("[fmu]\nkind = \"boat\"\n", None).unwrap_err();
+        assert!(e.contains("kind must be 'vessel' or 'load'"), "{e}");
+        let e = Layout::new(FIG2, None).unwrap_err();
+        assert!(e.contains("resources/vessel.toml"), "{e}");
+        let bad = PAPER_VESSEL_TOML.replace("mass = 6.3622085e6", "mass = -1.0");
+        let e = Layout::new(FIG2, Some(&bad)).unwrap_err();
+        assert!(e.contains("vessel.mass"), "{e}");
+        let e = Layout::new(
+            "[fmu]\n[simulation]\nmethod = \"rk5\"\n",
+            Some(PAPER_VESSEL_TOML),
+        )
+        .unwrap_err();
+        assert!(e.contains("method"), "{e}");
+    }
+
+    #[test]
+    fn setting_and_getting_follow_the_causalities() {
+        let l = fig2();
+        let mut inst = Instance::new(l.clone());
+        let e = inst
+            .set(vr(&l, "position.x"), Val::Real(1.0), false)
+            .unwrap_err();
+        assert!(e.contains("is an output"), "{e}");
+        let e = inst
+            .set(vr(&l, "method"), Val::Real(1.0), false)
+            .unwrap_err();
+        assert!(e.contains("method") && e.contains("String"), "{e}");
+        let e = inst.get_real(9999).unwrap_err();
+        assert!(e.contains("no variable has value reference 9999"), "{e}");
+        assert!(inst.get_real(vr(&l, "position.x")).is_err()); // before initialisation
+        assert!(inst.step(0.0, 1.0).unwrap_err().contains("not initialised"));
+        inst.set(vr(&l, "vessel.mass"), Val::Real(-3.0), false)
+            .unwrap();
+        let e = inst.initialize(0.0).unwrap_err();
+        assert!(e.contains("vessel.mass"), "{e}");
+        inst.set(vr(&l, "vessel.mass"), Val::Real(6.3622085e6), false)
+            .unwrap();
+        inst.initialize(0.0).unwrap();
+        let e = inst.set(vr(&l, "h"), Val::Real(0.1), true).unwrap_err();
+        assert!(e.contains("fixed parameter"), "{e}");
+        inst.set(vr(&l, "external_force.x"), Val::Real(1e5), true)
+            .unwrap();
+        assert_eq!(inst.get_real(vr(&l, "position.x")).unwrap(), 723.0);
+        let e = inst.step(0.5, 1.0).unwrap_err();
+        assert!(e.contains("communication point 0.5"), "{e}");
+        assert!(inst.step(0.0, f64::NAN).is_err());
+    }
+
+    /// Communication steps that are not multiples of h end with a shorter internal step: the
+    /// same state as the core's run of the same grid.
+    #[test]
+    fn a_partial_step_is_the_cores_run_of_the_same_grid() {
+        let l = fig2();
+        let mut inst = Instance::new(l.clone());
+        inst.initialize(0.0).unwrap();
+        inst.step(0.0, 1.3).unwrap(); // 0.5 + 0.5 + 0.3
+        let v = Vessel::from_table(inst.vessel_table().unwrap()).unwrap();
+        let sys = VesselSystem::new(&v, Some(50.0));
+        let opts = Options {
+            last_h: 0.3,
+            ..Options::steps(0.0, 0.5, 3, 3)
+        };
+        let m: phsplit_core::methods::Method = "sp4".parse().unwrap();
+        let traj = run(&sys, &m, v.initial_state(), &opts).unwrap();
+        let want = traj.states.last().unwrap().x;
+        for i in 0..3 {
+            let got = inst
+                .get_real(vr(&l, &format!("position.{}", XYZ[i])))
+                .unwrap();
+            assert_eq!(got, want[i]);
+        }
+        assert!((inst.time - 1.3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_load_is_its_formula() {
+        let l = Arc::new(Layout::new(
+            "[fmu]\nkind = \"load\"\n[load]\nforce_mean = [1.0, 2.0, 3.0]\nforce_amplitude = [0.5, 0.0, -1.0]\nperiod = 8.0\n",
+            None,
+        )
+        .unwrap());
+        let mut inst = Instance::new(l.clone());
+        inst.initialize(0.0).unwrap();
+        inst.step(0.0, 2.0).unwrap(); // a quarter period: sin = 1
+        let f: Vec<f64> = ["force.x", "force.y", "force.z", "moment.x"]
+            .iter()
+            .map(|n| inst.get_real(vr(&l, n)).unwrap())
+            .collect();
+        assert!((f[0] - 1.5).abs() < 1e-15 && f[1] == 2.0 && (f[2] - 2.0).abs() < 1e-15);
+        assert_eq!(f[3], 0.0);
+        inst.set(vr(&l, "period"), Val::Real(0.0), false).unwrap();
+        assert!(inst.initialize(0.0).unwrap_err().contains("period"));
+    }
+}
