@@ -17,7 +17,7 @@
 //! states from `fmi2GetFMUstate`). Null pointers are checked and refused.
 #![allow(clippy::missing_safety_doc)]
 
-use crate::model::{Instance, Layout, Val};
+use crate::model::{Instance, Layout, Mode, Val};
 use std::ffi::{c_char, c_int, c_uint, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Arc;
@@ -57,9 +57,6 @@ struct Component {
     env: *mut c_void,
     logging_on: bool,
     inst: Instance,
-    start_time: f64,
-    initialized: bool,
-    terminated: bool,
     /// The strings handed out by `fmi2GetString`, valid until the next call.
     strings: Vec<CString>,
 }
@@ -170,9 +167,6 @@ fn instantiate(
         env,
         logging_on,
         inst: Instance::new(layout),
-        start_time: 0.0,
-        initialized: false,
-        terminated: false,
         strings: Vec::new(),
     });
     if fmu_type != CO_SIMULATION {
@@ -184,7 +178,12 @@ fn instantiate(
     let Some(dir) = resources.as_deref().and_then(resource_dir) else {
         return Err((
             comp,
-            format!("fmuResourceLocation must be a file: URI of the unpacked resources folder, got {resources:?}"),
+            format!(
+                "fmuResourceLocation must be a file: URI of the unpacked resources folder, got {}",
+                resources
+                    .as_deref()
+                    .map_or("none".to_string(), |r| format!("{r:?}"))
+            ),
         ));
     };
     let read = |f: &str| std::fs::read_to_string(dir.join(f));
@@ -298,34 +297,58 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     _tolerance_defined: c_int,
     _tolerance: f64,
     start_time: f64,
-    _stop_time_defined: c_int,
-    _stop_time: f64,
+    stop_time_defined: c_int,
+    stop_time: f64,
 ) -> Fmi2Status {
     with(c, |comp| {
+        if comp.inst.mode != Mode::Instantiated {
+            return comp.fail(&format!(
+                "fmi2SetupExperiment: only after fmi2Instantiate or fmi2Reset (the FMU is in {:?} mode)",
+                comp.inst.mode
+            ));
+        }
         if !start_time.is_finite() {
             return comp.fail(&format!(
                 "fmi2SetupExperiment: startTime must be finite, got {start_time}"
             ));
         }
-        comp.start_time = start_time;
+        if stop_time_defined != 0 && !(stop_time.is_finite() && stop_time >= start_time) {
+            return comp.fail(&format!(
+                "fmi2SetupExperiment: stopTime must be finite and >= startTime {start_time}, got {stop_time}"
+            ));
+        }
+        comp.inst.start_time = start_time;
+        comp.inst.stop_time = (stop_time_defined != 0).then_some(stop_time);
         OK
     })
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Fmi2Status {
-    with(c, |_| OK)
+    with(c, |comp| {
+        if comp.inst.mode != Mode::Instantiated {
+            return comp.fail(&format!(
+                "fmi2EnterInitializationMode: only after fmi2Instantiate or fmi2Reset (the FMU is in {:?} mode)",
+                comp.inst.mode
+            ));
+        }
+        comp.inst.mode = Mode::Initialization;
+        OK
+    })
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Fmi2Status {
     with(c, |comp| {
-        let t0 = comp.start_time;
+        if comp.inst.mode != Mode::Initialization {
+            return comp.fail(&format!(
+                "fmi2ExitInitializationMode: only after fmi2EnterInitializationMode (the FMU is in {:?} mode)",
+                comp.inst.mode
+            ));
+        }
+        let t0 = comp.inst.start_time;
         match comp.inst.initialize(t0) {
-            Ok(()) => {
-                comp.initialized = true;
-                OK
-            }
+            Ok(()) => OK,
             Err(e) => comp.fail(&format!("fmi2ExitInitializationMode: {e}")),
         }
     })
@@ -334,7 +357,7 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Fmi2Statu
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> Fmi2Status {
     with(c, |comp| {
-        comp.terminated = true;
+        comp.inst.mode = Mode::Terminated;
         OK
     })
 }
@@ -343,8 +366,6 @@ pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> Fmi2Status {
 pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> Fmi2Status {
     with(c, |comp| {
         comp.inst = Instance::new(comp.inst.layout.clone());
-        comp.initialized = false;
-        comp.terminated = false;
         OK
     })
 }
@@ -379,7 +400,7 @@ fn get_each<T>(
     n: usize,
     out: *mut T,
     what: &str,
-    f: impl Fn(&mut Component, u32) -> std::result::Result<T, String>,
+    mut f: impl FnMut(&mut Component, u32) -> std::result::Result<T, String>,
 ) -> Fmi2Status {
     with(c, |comp| {
         if n > 0 && (vr.is_null() || out.is_null()) {
@@ -404,15 +425,21 @@ pub unsafe extern "C" fn fmi2GetReal(
     n: usize,
     v: *mut f64,
 ) -> Fmi2Status {
+    // Before fmi2ExitInitializationMode (a master reads the initial outputs in initialisation
+    // mode): the outputs of the state the parameters set so far give, built once per call.
+    let mut provisional: Option<std::result::Result<Instance, String>> = None;
     get_each(c, vr, n, v, "fmi2GetReal", |comp, r| {
-        if comp.initialized {
+        if comp.inst.initialized() {
             return comp.inst.get_real(r);
         }
-        // Before fmi2ExitInitializationMode (a master reads the initial outputs in
-        // initialisation mode): the outputs of the state the parameters set so far give.
-        let mut provisional = comp.inst.clone();
-        provisional.initialize(comp.start_time)?;
-        provisional.get_real(r)
+        let p = provisional.get_or_insert_with(|| {
+            let mut p = comp.inst.clone();
+            p.initialize(comp.inst.start_time).map(|()| p)
+        });
+        match p {
+            Ok(p) => p.get_real(r),
+            Err(e) => Err(e.clone()),
+        }
     })
 }
 
@@ -485,17 +512,22 @@ fn set_each<T: Copy>(
         let Some((vrs, vals)) = (unsafe { slices(vr, n, v) }) else {
             return comp.fail(&format!("{what}: null array for {n} values"));
         };
-        let init = comp.initialized;
+        // All or none: the values are checked before any is kept.
+        let mut items = Vec::with_capacity(vrs.len());
         for (r, x) in vrs.iter().zip(vals) {
-            let val = match conv(*x) {
-                Ok(v) => v,
-                Err(e) => return comp.fail(&format!("{what}: {e}")),
-            };
-            if let Err(e) = comp.inst.set(*r, val, init) {
-                return comp.fail(&format!("{what}: {e}"));
+            match conv(*x) {
+                Ok(v) => items.push((*r, v)),
+                Err(e) => {
+                    return comp.fail(&format!(
+                        "{what}: {e} (value reference {r}; none of the {n} values set)"
+                    ))
+                }
             }
         }
-        OK
+        match comp.inst.set_many(items) {
+            Ok(()) => OK,
+            Err(e) => comp.fail(&format!("{what}: {e} (none of the {n} values set)")),
+        }
     })
 }
 
@@ -578,7 +610,6 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, state: *mut c_void) -> 
         }
         // SAFETY: a state made by fmi2GetFMUstate of this FMU.
         comp.inst = unsafe { &*(state as *const Instance) }.clone();
-        comp.initialized = true;
         OK
     })
 }
@@ -686,11 +717,10 @@ pub unsafe extern "C" fn fmi2DoStep(
     _no_set_fmu_state_prior: c_int,
 ) -> Fmi2Status {
     with(c, |comp| {
-        if !comp.initialized {
-            return comp.fail("fmi2DoStep: call fmi2ExitInitializationMode first");
-        }
-        if comp.terminated {
-            return comp.fail("fmi2DoStep: the FMU was terminated");
+        match comp.inst.mode {
+            Mode::Stepping => {}
+            Mode::Terminated => return comp.fail("fmi2DoStep: the FMU was terminated"),
+            _ => return comp.fail("fmi2DoStep: call fmi2ExitInitializationMode first"),
         }
         match comp
             .inst

@@ -7,4 +7,4 @@
 pub mod ffi;
 pub mod model;
 
-pub use model::{Causality, Instance, Kind, Layout, Type, Val, Variable};
+pub use model::{Causality, Instance, Kind, Layout, Mode, Type, Val, Variable};

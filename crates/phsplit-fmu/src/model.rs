@@ -405,6 +405,12 @@ impl Layout {
             "",
             "project onto the restoring invariant after every internal step (energy-neutral)",
         );
+        b.setting(
+            "ledger",
+            Val::Boolean(s.ledger),
+            "",
+            "keep the energy ledger (energy.supplied, energy.dissipated and ledger.* are NaN without it; steps are several times cheaper)",
+        );
         let frame = base
             .get("external")
             .and_then(|e| e.get("frame"))
@@ -531,15 +537,44 @@ struct Running {
     dissipated: f64,
 }
 
-/// An FMU instance: the current values of the parameters and inputs, the time, and (after
-/// initialisation) the vessel's state. `Clone` is the FMU state of `fmi2GetFMUstate`.
+/// The FMI 2.0 co-simulation state of an instance (the standard's state machine).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// After `fmi2Instantiate`: parameters and the experiment can be set.
+    Instantiated,
+    /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`.
+    Initialization,
+    /// After `fmi2ExitInitializationMode`: `fmi2DoStep`.
+    Stepping,
+    /// After `fmi2Terminate`.
+    Terminated,
+}
+
+/// An FMU instance: its mode, the current values of the parameters and inputs, the experiment,
+/// the time, and (after initialisation) the vessel's state. `Clone` is the FMU state of
+/// `fmi2GetFMUstate`: all of it, the mode included.
 #[derive(Debug, Clone)]
 pub struct Instance {
     pub layout: Arc<Layout>,
     values: Vec<Option<Val>>,
+    pub mode: Mode,
+    /// `startTime` and `stopTime` of `fmi2SetupExperiment`.
+    pub start_time: f64,
+    pub stop_time: Option<f64>,
     pub time: f64,
     running: Option<Running>,
 }
+
+/// The components the inputs act through, and the tables they read.
+const INPUT_COMPONENTS: [&str; 3] = ["pid", "external", "current"];
+const INPUT_TABLES: [&str; 6] = [
+    "vessel",
+    "control",
+    "setpoint",
+    "thrusters",
+    "external",
+    "current",
+];
 
 /// How far a communication point may be from the instance's time (relative).
 const TIME_TOLERANCE: f64 = 1e-9;
@@ -550,9 +585,30 @@ impl Instance {
         Self {
             layout,
             values,
+            mode: Mode::Instantiated,
+            start_time: 0.0,
+            stop_time: None,
             time: 0.0,
             running: None,
         }
+    }
+
+    /// Whether parameters are fixed (after initialisation).
+    pub fn initialized(&self) -> bool {
+        matches!(self.mode, Mode::Stepping | Mode::Terminated)
+    }
+
+    /// Set several values at once: all or none (the first bad one is named).
+    pub fn set_many(&mut self, items: Vec<(u32, Val)>) -> Result<()> {
+        let before = self.values.clone();
+        let init = self.initialized();
+        for (vr, val) in items {
+            if let Err(e) = self.set(vr, val, init) {
+                self.values = before;
+                return Err(e);
+            }
+        }
+        Ok(())
     }
 
     fn var(&self, vr: u32, ty: Type) -> Result<&Variable> {
@@ -625,9 +681,27 @@ impl Instance {
 
     /// The vessel file with the parameters and inputs applied.
     fn vessel_table(&self) -> Result<Table> {
-        let mut t = self.layout.base.clone();
+        self.vessel_tables(None)
+    }
+
+    /// [`Self::vessel_table`], only the tables `only` (all with `None`): the components the
+    /// inputs act through read these, and the others (wave and wind tables) are large.
+    fn vessel_tables(&self, only: Option<&[&str]>) -> Result<Table> {
+        let mut t: Table = match only {
+            None => self.layout.base.clone(),
+            Some(names) => self
+                .layout
+                .base
+                .iter()
+                .filter(|(k, _)| names.contains(&k.as_str()))
+                .map(|(k, v)| (k.clone(), v.clone()))
+                .collect(),
+        };
         for (v, val) in self.layout.vars.iter().zip(&self.values) {
             if let (Role::VesselNumber { table, key, index }, Some(Val::Real(x))) = (&v.role, val) {
+                if !t.contains_key(table) {
+                    continue;
+                }
                 let slot = t
                     .get_mut(table)
                     .and_then(|s| s.as_table_mut())
@@ -715,8 +789,10 @@ impl Instance {
             (true, Some(Val::Real(tc))) => t.insert("control_start".into(), Value::Float(tc)),
             _ => t.insert("control_start".into(), Value::String("never".into())),
         };
-        if let Some(Val::Boolean(p)) = self.setting("project_invariants") {
-            t.insert("project_invariants".into(), Value::Boolean(p));
+        for key in ["project_invariants", "ledger"] {
+            if let Some(Val::Boolean(p)) = self.setting(key) {
+                t.insert(key.into(), Value::Boolean(p));
+            }
         }
         let (s, _) =
             Settings::from_table(&t).map_err(|e| e.to_string().replacen("simulation.", "", 1))?;
@@ -733,6 +809,16 @@ impl Instance {
     /// and start from the vessel file's `[initial]` state at `t0`.
     pub fn initialize(&mut self, t0: f64) -> Result<()> {
         self.time = t0;
+        let r = self.build_state();
+        self.mode = if r.is_ok() {
+            Mode::Stepping
+        } else {
+            Mode::Initialization
+        };
+        r
+    }
+
+    fn build_state(&mut self) -> Result<()> {
         if self.layout.kind == Kind::Load {
             let period = self.real(Role::Setting("period"));
             if !(period.is_finite() && period > 0.0) {
@@ -770,13 +856,26 @@ impl Instance {
                 self.time
             ));
         }
+        if let Some(stop) = self.stop_time {
+            if t + dt > stop + TIME_TOLERANCE * stop.abs().max(1.0) {
+                return Err(format!(
+                    "the step to t = {} s goes past the experiment's stopTime {stop} s",
+                    t + dt
+                ));
+            }
+        }
         if self.layout.kind == Kind::Load {
             self.time = t + dt;
             return Ok(());
         }
         let inputs = self.inputs();
         let rebuilt = match &self.running {
-            Some(r) if r.inputs != inputs => Some(Arc::new(self.build_vessel()?)),
+            // Only the components the inputs act through are read again.
+            Some(r) if r.inputs != inputs => Some(Arc::new(
+                r.vessel
+                    .with_rebuilt(self.vessel_tables(Some(&INPUT_TABLES))?, &INPUT_COMPONENTS)
+                    .map_err(|e| e.to_string())?,
+            )),
             Some(_) => None,
             None => return Err("the FMU is not initialised".into()),
         };
@@ -785,18 +884,7 @@ impl Instance {
             r.vessel = v;
             r.inputs = inputs;
         }
-        let h = r.settings.h;
-        let ratio = dt / h;
-        let whole = ratio.round();
-        let (n_steps, last_h) = if whole >= 1.0 && (ratio - whole).abs() <= 1e-9 * ratio {
-            (whole as usize, h)
-        } else if ratio < 1.0 {
-            (1, dt)
-        } else {
-            let n = ratio.floor();
-            (n as usize + 1, dt - n * h)
-        };
-        let h_run = if n_steps == 1 { last_h } else { h };
+        let (h_run, n_steps, last_h) = internal_steps(dt, r.settings.h);
         let opts = Options {
             t0: t,
             h: h_run,
@@ -804,14 +892,20 @@ impl Instance {
             last_h,
             save_every: n_steps,
             outer: r.settings.outer,
-            ledger: true,
+            ledger: r.settings.ledger,
         };
+        if let Err(e) = opts.validate() {
+            return Err(format!(
+                "the communication step {dt:e} s at t = {t} s asks for internal steps of {h_run:e} s and {last_h:e} s, which the time cannot resolve there ({e}); take communication steps that are multiples of h = {:e} s",
+                r.settings.h
+            ));
+        }
         let sys = VesselSystem::new(&r.vessel, r.settings.control_start)
             .with_linear_flow(r.settings.linear_flow)
             .with_projection(r.settings.project_invariants);
         let traj = run(&sys, &r.settings.method, r.state, &opts).map_err(|e| e.to_string())?;
         if let Status::Failed { t, reason, .. } = &traj.status {
-            return Err(format!("the vessel's state became non-finite in the step from t = {t} s ({reason}); the step is too long for this method or the inputs are extreme"));
+            return Err(format!("the internal step from t = {t} s failed: {reason}; the step h is too long for this method, or the inputs are extreme"));
         }
         let last = traj.states.len() - 1;
         r.state = traj.states[last];
@@ -891,14 +985,34 @@ impl Instance {
                 }
                 total[i]
             }
-            "energy" => match i {
-                0 => r.vessel.energy(s),
-                1 => r.supplied,
-                _ => r.dissipated,
-            },
+            "energy" if i == 0 => r.vessel.energy(s),
+            "energy" | "ledger" if !r.settings.ledger => f64::NAN,
+            "energy" if i == 1 => r.supplied,
+            "energy" => r.dissipated,
             "ledger" => r.booked[i],
             other => return Err(format!("internal: unknown output group {other}")),
         })
+    }
+}
+
+/// The internal steps of a communication step `dt` at the step `h`: `(h_run, n, last)`, `n`
+/// steps of `h_run` with the last one `last`. A multiple of `h` (to 1e-9 relative) is that many
+/// steps of `h`, as `phsplit.simulate` takes them; within 1e-6 of a multiple, that many equal
+/// steps (no sliver of a last step that the time could not resolve); a step shorter than `h` is
+/// one step; otherwise whole steps of `h` and a last shorter one.
+pub fn internal_steps(dt: f64, h: f64) -> (f64, usize, f64) {
+    let ratio = dt / h;
+    let whole = ratio.round();
+    if whole >= 1.0 && (ratio - whole).abs() <= 1e-9 * ratio {
+        (h, whole as usize, h)
+    } else if whole >= 1.0 && (ratio - whole).abs() <= 1e-6 * ratio {
+        let even = dt / whole;
+        (even, whole as usize, even)
+    } else if ratio < 1.0 {
+        (dt, 1, dt)
+    } else {
+        let n = ratio.floor();
+        (h, n as usize + 1, dt - n * h)
     }
 }
 
@@ -1041,6 +1155,21 @@ mod tests {
             assert_eq!(got, want[i]);
         }
         assert!((inst.time - 1.3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn internal_steps_cover_the_communication_step() {
+        assert_eq!(internal_steps(1.0, 0.5), (0.5, 2, 0.5));
+        assert_eq!(internal_steps(0.2, 0.5), (0.2, 1, 0.2));
+        let (h, n, last) = internal_steps(1.3, 0.5);
+        assert_eq!((h, n), (0.5, 3));
+        assert!((last - 0.3).abs() < 1e-15);
+        // A sliver over a multiple: equal steps instead of a last step of 1e-9 s.
+        let (h, n, last) = internal_steps(0.5 + 1e-9, 0.5);
+        assert_eq!((n, h, last), (1, 0.5 + 1e-9, 0.5 + 1e-9));
+        let (h, n, _) = internal_steps(3.0 + 1e-8, 0.5);
+        assert_eq!(n, 6);
+        assert!((h * 6.0 - (3.0 + 1e-8)).abs() < 1e-15);
     }
 
     #[test]

@@ -180,6 +180,11 @@ def _write_fmu(out: str | os.PathLike[str], name: str, description: str, resourc
                 info.external_attr = (0o100000 | mode) << 16
                 info.compress_type = zipfile.ZIP_DEFLATED
                 z.writestr(info, data)
+        # mkstemp made the file private (0600); an FMU is for others to read, as any file made
+        # under the user's umask.
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, out)
     except BaseException:
         try:

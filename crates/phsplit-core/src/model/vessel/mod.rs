@@ -132,6 +132,43 @@ impl Vessel {
         })
     }
 
+    /// The same vessel with the components named in `names` built again from `table` (this
+    /// vessel's file with some of their values changed); the other components are kept as they
+    /// are, and their tables are not read again. For values that change often, like the FMU's
+    /// inputs (the external load, the set point, the current): a rebuild of the whole vessel
+    /// reads every table (waves and wind coefficient tables included) each time.
+    pub fn with_rebuilt(&self, table: toml::Table, names: &[&str]) -> Result<Self> {
+        let mut p = Params::from_table(table);
+        let mut forces = Vec::with_capacity(self.forces.len());
+        for (name, _, build) in forces::COMPONENTS {
+            if names.contains(name) {
+                if let Some(f) = build(&mut p, &self.body)? {
+                    forces.push(f);
+                }
+            } else if let Some(f) = self.force(name) {
+                forces.push(f.clone());
+            }
+        }
+        let mut params = self.params.clone();
+        for (section, v) in p.read_so_far() {
+            if let (Some(toml::Value::Table(dst)), toml::Value::Table(src)) =
+                (params.get_mut(&section), &v)
+            {
+                for (k, x) in src {
+                    dst.insert(k.clone(), x.clone());
+                }
+            } else {
+                params.insert(section, v);
+            }
+        }
+        Ok(Self {
+            body: self.body.clone(),
+            initial: self.initial.clone(),
+            forces,
+            params,
+        })
+    }
+
     /// The tables a vessel file may have: the body's and initial state's, and the components'.
     pub fn tables() -> Vec<&'static str> {
         let mut t = vec!["vessel", "initial"];

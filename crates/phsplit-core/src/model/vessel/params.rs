@@ -310,6 +310,12 @@ impl Params {
         missing(section, key, unit)
     }
 
+    /// The normalised table of what was read, without the check for unread keys (for a
+    /// partial rebuild of a vessel whose file was checked whole before).
+    pub fn read_so_far(self) -> Table {
+        self.out
+    }
+
     /// Refuse every table and key that no component read; return the normalised table.
     pub fn finish(self) -> Result<Table> {
         for (section, v) in &self.input {

@@ -806,6 +806,52 @@ mod tests {
         }
     }
 
+    /// A partial rebuild (the FMU's inputs) gives the vessel a whole rebuild of the same file
+    /// gives: the same components, field and normalised parameters.
+    #[test]
+    fn a_partial_rebuild_is_a_whole_rebuild() {
+        let v = with_external("spatial");
+        let mut table = v.params.clone();
+        let ext = table["external"].as_table_mut().unwrap();
+        ext.insert(
+            "force".into(),
+            toml::Value::Array(vec![1e5.into(), 2e5.into(), (-3e4).into()]),
+        );
+        let ctl = table["control"].as_table_mut().unwrap();
+        ctl.insert(
+            "position_reference".into(),
+            toml::Value::Array(vec![790.0.into(), 25.0.into(), 0.0.into()]),
+        );
+        let part = v.with_rebuilt(table.clone(), &["external", "pid"]).unwrap();
+        let whole = Vessel::from_table(table).unwrap();
+        assert_eq!(part.params, whole.params);
+        let names = |x: &Vessel| x.forces.iter().map(|f| f.name()).collect::<Vec<_>>();
+        assert_eq!(names(&part), names(&whole));
+        let s = random_state(&v, [0.2, -0.4, 0.6, 0.3, -0.5, 0.1, 0.7, -0.3]);
+        let (a, b) = (
+            VesselSystem::new(&part, Some(0.0)),
+            VesselSystem::new(&whole, Some(0.0)),
+        );
+        assert_eq!(
+            a.vector_field(&s, 0.0, true).to_vector(),
+            b.vector_field(&s, 0.0, true).to_vector()
+        );
+        assert_ne!(
+            a.vector_field(&s, 0.0, true).to_vector(),
+            VesselSystem::new(&v, Some(0.0))
+                .vector_field(&s, 0.0, true)
+                .to_vector()
+        );
+        // A bad value in a rebuilt component is refused as in a whole build.
+        let mut bad = v.params.clone();
+        bad["external"].as_table_mut().unwrap().insert(
+            "point".into(),
+            toml::Value::Array(vec![0.0.into(), 0.0.into(), 5000.0.into()]),
+        );
+        let e = v.with_rebuilt(bad, &["external"]).unwrap_err().to_string();
+        assert!(e.contains("external.point[2]"), "{e}");
+    }
+
     #[test]
     fn external_table_is_validated() {
         let base = super::super::PAPER_VESSEL_TOML;
