@@ -339,3 +339,12 @@ CATALOGUE += [
         ("force_mean", "3 finite numbers")),
     Bad("FMU of a missing scenario", cli("fmu", "export", "nowhere.toml", "-o", "v.fmu"), C, ("nowhere.toml",)),
 ]
+
+CATALOGUE += [
+    # issue 18: quadratic damping
+    Bad("quadratic damping with 2 coefficients",
+        vessel_with("[control]", "[damping_quadratic]\ncoefficients = [1.0, 2.0]\n\n[control]"), E, ("6 numbers",)),
+    Bad("quadratic damping with a negative coefficient",
+        vessel_with("[control]", "[damping_quadratic]\ncoefficients = [1, -2, 0, 0, 0, 0]\n\n[control]"), E,
+        ("damping_quadratic.coefficients[1]", "≥ 0")),
+]

@@ -66,6 +66,9 @@ class Field:
         # the moving set point: the third-order filter's states are integrated with the vessel
         # (y[27:45]: x_d, x_d', x_d'' for the six channels), driven by the set point r(t)
         self.sp = dict(sp) if sp else None
+        dq = params.get("damping_quadratic")
+        # Fossen's diagonal quadratic damping, c_i |nu_i| nu_i, on the velocity relative to the water
+        self.cq = np.array(dq["coefficients"], float) if dq else np.zeros(6)
         cur = params.get("current")
         # a uniform current V_c (spatial): the translational damping acts on v - Q^T V_c
         self.vc = np.array(cur.get("velocity", [0.0] * 3), float) if cur else np.zeros(3)
@@ -253,8 +256,9 @@ class Field:
             dy[27:45] = np.concatenate([f[1], f[2], jerk])
         vc = self.vc if self.vc_table is None else np.array(
             [np.interp(t, self.vc_table[0], self.vc_table[1][:, i]) for i in range(3)])
-        dy[0:3] = -np.cross(w, p) - (self.Dt * (v - Q.T @ vc) + Q.T @ (self.lam * x) - tau_t) + fe
-        dy[3:6] = -np.cross(w, m) - (self.Dr * w + np.cross(mu, q3) - tau_r) + me
+        vr = v - Q.T @ vc
+        dy[0:3] = -np.cross(w, p) - (self.Dt * vr + self.cq[:3] * np.abs(vr) * vr + Q.T @ (self.lam * x) - tau_t) + fe
+        dy[3:6] = -np.cross(w, m) - (self.Dr * w + self.cq[3:] * np.abs(w) * w + np.cross(mu, q3) - tau_r) + me
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)
         dy[18:21] = Q @ v

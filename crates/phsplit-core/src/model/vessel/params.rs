@@ -298,7 +298,7 @@ impl Params {
     }
 
     /// A required key is absent: a misspelling of it is named as such, else it is missing.
-    fn missing(&self, section: &str, key: &str, unit: &str) -> Error {
+    pub fn missing(&self, section: &str, key: &str, unit: &str) -> Error {
         if let Some(Value::Table(t)) = self.input.get(section) {
             let want = [key.to_string()];
             if let Some(typo) = t.keys().find(|k| nearest(k, &want).is_some()) {

@@ -14,6 +14,11 @@
 //! as the work of the port `current` (supplied; it is negative when the vessel moves against
 //! the current faster than the current would carry it). The ledger closes as before.
 //!
+//! **With quadratic damping** (`[damping_quadratic]`) this component also adds the rest of the
+//! quadratic drag on the relative velocity, `C ∘ (|v| ∘ v − |v_r| ∘ v_r)` (docs/model.md §5.11),
+//! booked to `current` as well; it is a forcing of flow S2, its linearisation at the sub-step's
+//! start in the implicit rows.
+//!
 //! **A slowly varying current** (a time table): instead of `velocity`, `times` (s, increasing)
 //! and `velocities` (one row of 3 numbers per time, m/s, spatial): the current moves linearly
 //! between the rows and stays at the first and last row outside them. It is then a forcing of
@@ -41,6 +46,9 @@ pub struct Current {
     pub table: Option<(Vec<f64>, Vec<Vector3<f64>>)>,
     /// Diagonal of the translational damping `D_t` (kg/s), the vessel's.
     pub damping: Vector3<f64>,
+    /// The translational coefficients of the vessel's quadratic damping (kg/m), if it has one
+    /// (`[damping_quadratic]`).
+    pub quadratic: Option<Vector3<f64>>,
 }
 
 pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
@@ -110,10 +118,12 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         "kg/s",
         Range::NonNegative,
     )?;
+    let quadratic = super::damping_quadratic::coefficients(p)?.map(|c| c.0);
     Ok(Some(Arc::new(Current {
         velocity: velocity.into(),
         table,
         damping: damping.into(),
+        quadratic,
     })))
 }
 
@@ -122,7 +132,31 @@ const ACCOUNTS: [Account; 1] = [Account {
     kind: AccountKind::Supplied,
 }];
 
+/// The current's part of the quadratic damping at the body velocity `v` and the current `vc`
+/// (body frame): `C ∘ (|v| ∘ v − |v − vc| ∘ (v − vc))`, so that with the damping's own
+/// `−C ∘ |v| ∘ v` the force is the relative velocity's, `−C ∘ |v_r| ∘ v_r`.
+fn quadratic_part(c: &Vector3<f64>, v: &Vector3<f64>, vc: &Vector3<f64>) -> Vector3<f64> {
+    let vr = v - vc;
+    c.component_mul(&(v.abs().component_mul(v) - vr.abs().component_mul(&vr)))
+}
+
 impl Current {
+    /// The linearisation of [`quadratic_part`] at the sub-step's start (velocity `ν₀`, the
+    /// current of the constant case or of the table's first row): `J v + c0` with
+    /// `J = diag(2 C ∘ (|v₀| − |v₀ − v_c|))`. In the implicit rows, it keeps the fixed point of
+    /// the forcing contractive at long steps; the forcing carries the rest.
+    fn quadratic_linearisation(
+        &self,
+        fr: &Frozen,
+        c: &Vector3<f64>,
+    ) -> (nalgebra::Matrix3<f64>, Vector3<f64>) {
+        let v0 = fr.velocity[0];
+        let vc0 = fr.qt * self.velocity;
+        let j = (c * 2.0).component_mul(&(v0.abs() - (v0 - vc0).abs()));
+        let c0 = quadratic_part(c, &v0, &vc0) - j.component_mul(&v0);
+        (nalgebra::Matrix3::from_diagonal(&j), c0)
+    }
+
     /// The body-frame force of the constant current at attitude `Qᵀ = qt`: `D_t Qᵀ V_c`.
     pub fn body_force(&self, qt: &nalgebra::Matrix3<f64>) -> Vector3<f64> {
         self.damping.component_mul(&(qt * self.velocity))
@@ -160,19 +194,38 @@ impl Force for Current {
                 &Rows::constant(self.body_force(&fr.qt)),
             );
         }
+        if let Some(c) = &self.quadratic {
+            let (lin, c0) = self.quadratic_linearisation(fr, c);
+            b.force(
+                Sys::Trans,
+                Some(0),
+                &Rows {
+                    fu: lin / fr.body.mass,
+                    c: c0,
+                    ..Rows::ZERO
+                },
+            );
+        }
     }
     fn forced(&self) -> bool {
-        self.table.is_some()
+        self.table.is_some() || self.quadratic.is_some()
     }
     fn forcing_uses_state(&self) -> bool {
-        false
+        self.quadratic.is_some()
     }
-    fn add_forcing(&self, fr: &Frozen, t: f64, _z: &[Z3; 2], g: &mut Forcing) {
-        let v = self.velocity_at(t);
-        g.force(
-            Sys::Trans,
-            Some(0),
-            self.damping.component_mul(&(fr.qt * v)),
-        );
+    fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
+        let vc = fr.qt * self.velocity_at(t);
+        if self.table.is_some() {
+            g.force(Sys::Trans, Some(0), self.damping.component_mul(&vc));
+        }
+        if let Some(c) = &self.quadratic {
+            // The quadratic damping on the relative velocity: C ∘ (|v| v − |v − v_c| (v − v_c)),
+            // less its linearisation at the sub-step's start, which add_s2 puts in the
+            // implicit rows.
+            let v = z[0][0] / fr.body.mass;
+            let (lin, c0) = self.quadratic_linearisation(fr, c);
+            let f = quadratic_part(c, &v, &vc);
+            g.force(Sys::Trans, Some(0), f - lin * v - c0);
+        }
     }
 }

@@ -39,6 +39,7 @@ use std::sync::Arc;
 
 pub mod current;
 pub mod damping;
+pub mod damping_quadratic;
 pub mod external;
 pub mod pid;
 pub mod pipe;
@@ -55,6 +56,11 @@ pub type Build = fn(&mut Params, &Body) -> Result<Option<Arc<dyn Force>>>;
 /// its name, the tables of the vessel file its keys are in, and its builder.
 pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("damping", &["vessel"], damping::build),
+    (
+        "damping_quadratic",
+        &["damping_quadratic"],
+        damping_quadratic::build,
+    ),
     ("restoring", &["vessel"], restoring::build),
     ("pid", &["control", "setpoint", "thrusters"], pid::build),
     ("external", &["external"], external::build),
@@ -122,6 +128,10 @@ pub struct Frozen<'a> {
     /// Whether the controller acts on this step.
     pub control_on: bool,
     pub body: &'a Body,
+    /// The body velocities `ν₀ = M⁻¹u` (linear, angular) where the sub-step starts (zero for a
+    /// view at rest): a component whose force is not affine may put its linearisation there
+    /// into the implicit rows and only the rest into its forcing (`damping_quadratic.rs`).
+    pub velocity: [Vector3<f64>; 2],
 }
 
 /// Flow S2 at a frozen attitude under assembly: the two block systems, and, when the ledger

@@ -34,7 +34,7 @@ impl VesselSystem<'_> {
         ledger: bool,
         stages: usize,
     ) -> Work {
-        let fr = self.frozen(&s.q, on);
+        let fr = self.frozen(s, on);
         let b = self.s2_of(&fr, ledger);
         let z0 = self.blocks_of(s);
         let (z1, work) = if self.forced {
@@ -108,7 +108,10 @@ impl VesselSystem<'_> {
         };
         let z0t = [pack(&z0[0], 0, 1.0), pack(&z0[1], 1, 1.0)];
         let mut stage_z = [*z0; 3];
-        let mut ys = [[SVector::<f64, 10>::zeros(); 3]; 2];
+        // The stage iterates, balanced, starting from z0 (as stage_z does).
+        let mut ys: [[SVector<f64, 10>; 3]; 2] = std::array::from_fn(|k| {
+            std::array::from_fn(|i| if i < s { z0t[k] } else { SVector::zeros() })
+        });
         let mut g = [Forcing::new(); 3];
         // The parts that depend on time only, once per stage; the rest per pass.
         let fixed: [Forcing; 3] = std::array::from_fn(|i| {
@@ -120,6 +123,14 @@ impl VesselSystem<'_> {
         });
         let stateful = self.forced_stateful;
         let mut last_change = f64::INFINITY;
+        // Aitken's relaxation of the fixed point (B. M. Irons, R. C. Tuck, Int. J. Numer. Meth.
+        // Eng. 1 (1969) 275–277; in the form of U. Küttler, W. A. Wall, Comput. Mech. 43 (2008)
+        // 61–72, eq. 44): x ← x + ω r with r = G(x) − x and ω ← −ω r_oldᵀ(r − r_old)/|r − r_old|².
+        // A dissipative forcing (quadratic damping at long steps) makes the plain iteration
+        // oscillate with a rate that can pass 1; the relaxation damps that, and leaves a
+        // quickly converging iteration as it was (ω ≈ 1).
+        let mut omega = 1.0;
+        let mut prev_r: Option<[[SVector<f64, 10>; 3]; 2]> = None;
         for it in 0..FORCED_MAX_ITERATIONS {
             for i in 0..s {
                 g[i] = fixed[i];
@@ -128,6 +139,7 @@ impl VesselSystem<'_> {
                 }
             }
             let mut change: f64 = 0.0;
+            let mut r = [[SVector::<f64, 10>::zeros(); 3]; 2];
             for k in 0..2 {
                 let gt: [SVector<f64, 10>; 3] = std::array::from_fn(|j| {
                     if j < s {
@@ -148,13 +160,32 @@ impl VesselSystem<'_> {
                     return nan;
                 };
                 for i in 0..s {
-                    let yi: SVector<f64, 10> = y.fixed_rows::<10>(10 * i).into_owned();
+                    r[k][i] = y.fixed_rows::<10>(10 * i) - ys[k][i];
+                }
+            }
+            if let Some(pr) = &prev_r {
+                let (mut num, mut den) = (0.0, 0.0);
+                for k in 0..2 {
+                    for i in 0..s {
+                        let d = r[k][i] - pr[k][i];
+                        num += pr[k][i].dot(&d);
+                        den += d.norm_squared();
+                    }
+                }
+                if den > 0.0 && num.is_finite() {
+                    omega = (-omega * num / den).clamp(0.05, 2.0);
+                }
+            }
+            for k in 0..2 {
+                for i in 0..s {
+                    let yi = ys[k][i] + r[k][i] * omega;
                     let size = yi.amax().max(f64::MIN_POSITIVE);
                     change = change.max((yi - ys[k][i]).amax() / size);
                     ys[k][i] = yi;
                     stage_z[i][k] = unpack(&yi, k);
                 }
             }
+            prev_r = Some(r);
             if !change.is_finite() {
                 return nan;
             }
