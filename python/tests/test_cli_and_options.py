@@ -141,6 +141,29 @@ def test_vector_field_binding_matches_the_independent_model():
     np.testing.assert_allclose(f(-1.0, y), g0(-1.0, y), rtol=0, atol=1e-13 * np.abs(g0(-1.0, y)).max())
 
 
+def test_the_compiled_dop853_peer_matches_the_independent_model():
+    """The work-precision study's compiled peer (DOP853 in Rust on the compiled field, issue 17)
+    against the numpy model by scipy's DOP853 at rtol 1e-13, across the controller's start, and
+    its error falls with its tolerance."""
+    from phsplit import _core
+    import reference as ref
+
+    v = phsplit.Vessel.paper()
+    y0 = v.initial_state()
+    _, yr = ref.solve(v.to_dict(), y0, 40.0, 10.0, rtol=1e-13)
+    want = yr[-1]
+    f = _core.VectorField(v._inner, 10.0)
+    scale = np.maximum(np.abs(y0), 1.0)
+    errs = []
+    for rtol in (1e-5, 1e-8, 1e-11):
+        y, nfev, steps = f.solve_dop853((0.0, 40.0), y0, rtol, rtol * scale * 1e-3)
+        errs.append(np.linalg.norm(y[0:6] - want[0:6]) / np.linalg.norm(want[0:6]))
+        assert nfev >= 11 * steps > 0
+    assert errs[2] < 1e-8 and errs[0] > errs[1] > errs[2], errs
+    with pytest.raises(phsplit.InvalidInputError, match="t_span"):
+        f.solve_dop853((5.0, 1.0), y0, 1e-6, np.array([1e-9]))
+
+
 def test_chunked_cli_output_equals_one_simulate_call(tmp_path):
     assert main(["simulate", "--out", str(tmp_path), "--no-plot", "--save-every", "3"]) == 0
     s = phsplit.simulate(phsplit.Vessel.paper(), save_every=3)
