@@ -299,7 +299,7 @@ impl PyVectorField {
                 a.len()
             )));
         }
-        if !(rtol > 0.0 && rtol.is_finite()) || !a.iter().all(|x| *x > 0.0 && x.is_finite()) {
+        if !(rtol > 0.0 && rtol.is_finite() && a.iter().all(|x| *x > 0.0 && x.is_finite())) {
             return Err(InvalidInputError::new_err(
                 "rtol and atol must be finite and > 0",
             ));
