@@ -2,4 +2,5 @@
 //! by the matrix exponential, and Gauss collocation (flow S2).
 pub mod affine;
 pub mod collocation;
+pub mod kirchhoff;
 pub mod rigid_body;
