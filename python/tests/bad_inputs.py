@@ -348,3 +348,13 @@ CATALOGUE += [
         vessel_with("[control]", "[damping_quadratic]\ncoefficients = [1, -2, 0, 0, 0, 0]\n\n[control]"), E,
         ("damping_quadratic.coefficients[1]", "≥ 0")),
 ]
+
+CATALOGUE += [
+    # issue 18: cross-flow drag
+    Bad("cross-flow drag with the hull's ends reversed",
+        vessel_with("[control]", "[crossflow_drag]\ndraft = 4.5\ndrag_coefficient = 1.0\nx_aft = 40.0\nx_fore = -36.0\n\n[control]"),
+        E, ("x_aft < x_fore",)),
+    Bad("cross-flow drag without its draught",
+        vessel_with("[control]", "[crossflow_drag]\ndrag_coefficient = 1.0\nx_aft = -36.0\nx_fore = 40.0\n\n[control]"),
+        (phsplit.InvalidInputError, phsplit.ScenarioParseError), ("draft",)),
+]

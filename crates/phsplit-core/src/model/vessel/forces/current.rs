@@ -51,7 +51,13 @@ pub struct Current {
     pub quadratic: Option<Vector3<f64>>,
 }
 
-pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+    Ok(read(p, body)?.map(|c| Arc::new(c) as Arc<dyn Force>))
+}
+
+/// The current of the file's `[current]` table, if any (also read by `crossflow.rs`, whose drag
+/// acts on the velocity relative to the water).
+pub fn read(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Current>> {
     const T: &str = "current";
     p.declare(T);
     if !p.has(T) {
@@ -119,12 +125,12 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         Range::NonNegative,
     )?;
     let quadratic = super::damping_quadratic::coefficients(p)?.map(|c| c.0);
-    Ok(Some(Arc::new(Current {
+    Ok(Some(Current {
         velocity: velocity.into(),
         table,
         damping: damping.into(),
         quadratic,
-    })))
+    }))
 }
 
 const ACCOUNTS: [Account; 1] = [Account {

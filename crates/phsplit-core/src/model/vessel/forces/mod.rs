@@ -37,6 +37,7 @@ use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use std::sync::Arc;
 
+pub mod crossflow;
 pub mod current;
 pub mod damping;
 pub mod damping_quadratic;
@@ -61,6 +62,7 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
         &["damping_quadratic"],
         damping_quadratic::build,
     ),
+    ("crossflow_drag", &["crossflow_drag"], crossflow::build),
     ("restoring", &["vessel"], restoring::build),
     ("pid", &["control", "setpoint", "thrusters"], pid::build),
     ("external", &["external"], external::build),
