@@ -36,8 +36,11 @@ class Field:
         h, c = params["vessel"], params["control"]
         self.mv = h["mass"]
         self.T = np.array(h["inertia"])
-        self.Dt = np.array(h["damping_translational"])
-        self.Dr = np.array(h["damping_rotational"])
+        if "damping_matrix" in h:  # a full 6x6 linear damping on (v - v_c, w)
+            self.D = np.array(h["damping_matrix"], float)
+        else:
+            self.D = np.diag(np.concatenate([h["damping_translational"], h["damping_rotational"]]))
+        self.Dt = np.diag(self.D)[:3]
         self.lam = np.array([0.0, 0.0, h["gravity"] * h["water_density"] * h["waterplane_area"]])
         w = self.mv * h["gravity"]
         self.G = np.array([w * h["gm_longitudinal"], w * h["gm_transverse"], 0.0])
@@ -272,8 +275,9 @@ class Field:
             mz = -k * quad(lambda xx: xx * s(xx), xa, xf, points=knot, epsabs=1e-12, epsrel=1e-13, limit=200)[0]
             fe = fe + np.array([0.0, fy, 0.0])
             me = me + np.array([0.0, 0.0, mz])
-        dy[0:3] = -np.cross(w, p) - (self.Dt * vr + self.cq[:3] * np.abs(vr) * vr + Q.T @ (self.lam * x) - tau_t) + fe
-        dy[3:6] = -np.cross(w, m) - (self.Dr * w + self.cq[3:] * np.abs(w) * w + np.cross(mu, q3) - tau_r) + me
+        fd = self.D @ np.concatenate([vr, w])
+        dy[0:3] = -np.cross(w, p) - (fd[:3] + self.cq[:3] * np.abs(vr) * vr + Q.T @ (self.lam * x) - tau_t) + fe
+        dy[3:6] = -np.cross(w, m) - (fd[3:] + self.cq[3:] * np.abs(w) * w + np.cross(mu, q3) - tau_r) + me
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)
         dy[18:21] = Q @ v

@@ -5,7 +5,9 @@
 //! definite (rigid-body mass with its centre of gravity anywhere, plus added mass, any coupling),
 //! the conservative part of the motion is
 //!
-//!     p' = p × ω,     m' = m × ω + p × v,     Q' = Q ω̂,     ν = M⁻¹ u
+//! ```text
+//! p' = p × ω,     m' = m × ω + p × v,     Q' = Q ω̂,     ν = M⁻¹ u
+//! ```
 //!
 //! (G. Kirchhoff 1869; the Lie–Poisson equations of se(3)*, e.g. J. E. Marsden, T. S. Ratiu,
 //! *Introduction to Mechanics and Symmetry*, 2nd ed., Springer 1999, §1.4; Fossen's `C(ν)ν`

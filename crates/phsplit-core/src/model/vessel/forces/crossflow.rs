@@ -2,7 +2,9 @@
 //! docs/model.md §5.12). T. I. Fossen, *Handbook of Marine Craft Hydrodynamics and Motion
 //! Control*, 2nd ed., Wiley 2021, §6.4.3 (after Faltinsen 1990):
 //!
-//!     Y = −½ ρ ∫ T C_d |v_r + x r| (v_r + x r) dx,     N = −½ ρ ∫ x T C_d |v_r + x r| (v_r + x r) dx
+//! ```text
+//! Y = −½ ρ ∫ T C_d |v_r + x r| (v_r + x r) dx,     N = −½ ρ ∫ x T C_d |v_r + x r| (v_r + x r) dx
+//! ```
 //!
 //! over the hull's length `x ∈ [x_aft, x_fore]` (body frame, from the body origin), with the
 //! draught `T` and the 2-D drag coefficient `C_d` constant along it (Fossen takes `C_d` from

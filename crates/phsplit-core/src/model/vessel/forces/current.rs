@@ -8,7 +8,9 @@
 //! added mass, as the paper's, that is the whole load of a constant irrotational current). The
 //! rotational damping is unchanged (an irrotational current).
 //!
-//! The damping component keeps its force `−D_t v` and its account (dissipated, `vᵀD_t v`);
+//! The damping component keeps its force `−D ν` and its account (dissipated, `νᵀDν`); with a
+//! full damping matrix (`vessel.damping_matrix`) the current's part is `D_tt Qᵀ V_c` on the force
+//! and `D_rt Qᵀ V_c` on the moment.
 //! this component adds the rest, `+D_t Qᵀ V_c`. At frozen attitude that is constant, so it
 //! enters flow S2 as an affine term, exactly solvable, and its power `v·D_t Qᵀ V_c` is booked
 //! as the work of the port `current` (supplied; it is negative when the vessel moves against
@@ -44,8 +46,10 @@ pub struct Current {
     pub velocity: Vector3<f64>,
     /// The time table `(t, V_c)`, if the current varies.
     pub table: Option<(Vec<f64>, Vec<Vector3<f64>>)>,
-    /// Diagonal of the translational damping `D_t` (kg/s), the vessel's.
-    pub damping: Vector3<f64>,
+    /// The vessel's linear damping on a translational velocity: its force block `D_tt` (kg/s)
+    /// and its moment block `D_rt` (kg m/s; zero for the paper's diagonal damping).
+    pub damping: nalgebra::Matrix3<f64>,
+    pub damping_moment: nalgebra::Matrix3<f64>,
     /// The translational coefficients of the vessel's quadratic damping (kg/m), if it has one
     /// (`[damping_quadratic]`).
     pub quadratic: Option<Vector3<f64>>,
@@ -117,18 +121,15 @@ pub fn read(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Current
             )));
         }
     }
-    let damping = p.vec3(
-        "vessel",
-        "damping_translational",
-        None,
-        "kg/s",
-        Range::NonNegative,
-    )?;
+    let d = super::damping::read_matrix(p)?;
+    let damping = d.fixed_view::<3, 3>(0, 0).into_owned();
+    let damping_moment = d.fixed_view::<3, 3>(3, 0).into_owned();
     let quadratic = super::damping_quadratic::coefficients(p)?.map(|c| c.0);
     Ok(Some(Current {
         velocity: velocity.into(),
         table,
-        damping: damping.into(),
+        damping,
+        damping_moment,
         quadratic,
     }))
 }
@@ -163,9 +164,9 @@ impl Current {
         (nalgebra::Matrix3::from_diagonal(&j), c0)
     }
 
-    /// The body-frame force of the constant current at attitude `Qᵀ = qt`: `D_t Qᵀ V_c`.
+    /// The body-frame force of the constant current at attitude `Qᵀ = qt`: `D_tt Qᵀ V_c`.
     pub fn body_force(&self, qt: &nalgebra::Matrix3<f64>) -> Vector3<f64> {
-        self.damping.component_mul(&(qt * self.velocity))
+        self.damping * (qt * self.velocity)
     }
 
     /// The current at time `t` (m/s, spatial).
@@ -194,11 +195,11 @@ impl Force for Current {
     }
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
         if self.table.is_none() {
-            b.force(
-                Sys::Trans,
-                Some(0),
-                &Rows::constant(self.body_force(&fr.qt)),
-            );
+            let vc = fr.qt * self.velocity;
+            b.force(Sys::Trans, Some(0), &Rows::constant(self.damping * vc));
+            if self.damping_moment.amax() > 0.0 {
+                b.force(Sys::Rot, Some(0), &Rows::constant(self.damping_moment * vc));
+            }
         }
         if let Some(c) = &self.quadratic {
             let (lin, c0) = self.quadratic_linearisation(fr, c);
@@ -222,7 +223,8 @@ impl Force for Current {
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
         let vc = fr.qt * self.velocity_at(t);
         if self.table.is_some() {
-            g.force(Sys::Trans, Some(0), self.damping.component_mul(&vc));
+            g.force(Sys::Trans, Some(0), self.damping * vc);
+            g.force(Sys::Rot, Some(0), self.damping_moment * vc);
         }
         if let Some(c) = &self.quadratic {
             // The quadratic damping on the relative velocity: C ∘ (|v| v − |v − v_c| (v − v_c)),

@@ -1,43 +1,123 @@
-//! Linear hydrodynamic damping (paper §3.4, eq. 39: `Dt v`, `Dr w`; docs/model.md §2, §5).
+//! Linear hydrodynamic damping (paper §3.4, eq. 39: `Dt v`, `Dr w`; docs/model.md §2, §5, §5.13).
 //!
-//! Diagonal damping `D = diag(Dt, Dr)` ≥ 0 in the body frame: the force `−Dt v` and the
-//! moment `−Dr w`. Dissipative: the ledger books `νᵀDν ≥ 0` to the account `damping`.
-//! Flow S2.
+//! The damping force is `−D ν` in the body frame, with `D` symmetric positive semidefinite:
+//! - the paper's diagonal form, `vessel.damping_translational` (Dt: surge, sway, heave, kg/s) and
+//!   `vessel.damping_rotational` (Dr: roll, pitch, yaw, kg m²/s), or
+//! - a full 6×6 matrix `vessel.damping_matrix` (rows of 6; Fossen's `D_L`, e.g. with the
+//!   sway–yaw couplings `Y_r`, `N_v` of a real hull), checked symmetric (to 1e-12) and positive
+//!   semidefinite (its smallest eigenvalue `≥ −1e-12 max|D|`, else refused naming that eigenvalue).
+//!
+//! Dissipative: the ledger books `νᵀDν ≥ 0` to the account `damping`. In flow S2 the blocks
+//! within translation and within rotation are affine rows (exact flow possible); the couplings
+//! between the two block systems (`D_tr ω` on the force, `D_rt v` on the moment), when nonzero,
+//! are a forcing, linear in the state (Gauss collocation, docs/model.md §3.7), booked to the same
+//! account: at the Gauss stages the account is `h Σ b_i ν_iᵀ D ν_i ≥ 0`, so S2 stays dissipative.
 
-use super::{Force, Frozen, Rows, S2Builder, Sys};
+use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
+use crate::error::Error;
+use crate::flows::collocation::Z3;
 use crate::model::vessel::params::{Params, Range};
 use crate::solve::{Account, AccountKind};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, SMatrix, Vector3};
 use std::sync::Arc;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Damping {
-    /// `Dt`: surge, sway, heave, kg/s.
-    pub translational: Vector3<f64>,
-    /// `Dr`: roll, pitch, yaw, kg m²/s.
-    pub rotational: Vector3<f64>,
+    /// `D`, 6×6, body frame: `[[D_tt, D_tr], [D_rt, D_rr]]` on `ν = (v, ω)`.
+    pub matrix: SMatrix<f64, 6, 6>,
+    /// Whether `D_tr` or `D_rt` is nonzero (then the couplings are a forcing).
+    coupled: bool,
 }
 
-/// Keys `vessel.damping_translational`, `vessel.damping_rotational` (both required, ≥ 0).
+impl Damping {
+    /// `D_tt`, `D_tr`, `D_rt`, `D_rr`.
+    pub fn blocks(&self) -> [Matrix3<f64>; 4] {
+        let b = |i, j| self.matrix.fixed_view::<3, 3>(i, j).into_owned();
+        [b(0, 0), b(0, 3), b(3, 0), b(3, 3)]
+    }
+}
+
+/// The vessel's linear damping matrix from its file: the diagonal keys or `damping_matrix`
+/// (also read by `current.rs`, whose force is the damping's on the current's velocity).
+pub fn read_matrix(p: &mut Params) -> crate::Result<SMatrix<f64, 6, 6>> {
+    const T: &str = "vessel";
+    const UNIT: &str = "kg/s, kg m/s and kg m^2/s blocks";
+    let full = p.rows(T, "damping_matrix", 6, UNIT, Range::Finite)?;
+    let has_diag = p.take_raw(T, "damping_translational")?.is_some()
+        || p.take_raw(T, "damping_rotational")?.is_some();
+    match full {
+        Some(rows) => {
+            if has_diag {
+                return Err(Error::InvalidInput(
+                    "[vessel] takes either damping_matrix (6×6) or damping_translational and damping_rotational (its diagonal), not both".into(),
+                ));
+            }
+            if rows.len() != 6 {
+                return Err(Error::InvalidInput(format!(
+                    "vessel.damping_matrix must be 6 rows of 6 numbers ({UNIT}), got {} rows",
+                    rows.len()
+                )));
+            }
+            let d = SMatrix::<f64, 6, 6>::from_fn(|i, j| rows[i][j]);
+            check_psd(&d, "vessel.damping_matrix")?;
+            Ok(d)
+        }
+        None => {
+            let t = p.vec3(T, "damping_translational", None, "kg/s", Range::NonNegative)?;
+            let r = p.vec3(
+                T,
+                "damping_rotational",
+                None,
+                "kg m^2/s",
+                Range::NonNegative,
+            )?;
+            let mut d = SMatrix::<f64, 6, 6>::zeros();
+            for i in 0..3 {
+                d[(i, i)] = t[i];
+                d[(i + 3, i + 3)] = r[i];
+            }
+            Ok(d)
+        }
+    }
+}
+
+/// Symmetric (to 1e-12 of its largest entry) and positive semidefinite (smallest eigenvalue
+/// `≥ −1e-12` of its largest entry); the message names the matrix and the failing value.
+pub fn check_psd(d: &SMatrix<f64, 6, 6>, name: &str) -> crate::Result<()> {
+    let scale = d.amax();
+    let asym = (d - d.transpose()).amax();
+    if asym > 1e-12 * scale {
+        let (mut bi, mut bj, mut worst) = (0, 0, 0.0);
+        for i in 0..6 {
+            for j in 0..6 {
+                let x = (d[(i, j)] - d[(j, i)]).abs();
+                if x > worst {
+                    (bi, bj, worst) = (i, j, x);
+                }
+            }
+        }
+        return Err(Error::InvalidInput(format!(
+            "{name} must be symmetric: entry [{bi}][{bj}] = {} but [{bj}][{bi}] = {}",
+            d[(bi, bj)],
+            d[(bj, bi)]
+        )));
+    }
+    let min = d.symmetric_eigenvalues().min();
+    if min < -1e-12 * scale {
+        return Err(Error::InvalidInput(format!(
+            "{name} must be positive semidefinite (a damping dissipates); its smallest eigenvalue is {min:e}"
+        )));
+    }
+    Ok(())
+}
+
+/// Keys `vessel.damping_translational` and `vessel.damping_rotational` (≥ 0), or
+/// `vessel.damping_matrix` (6×6, symmetric positive semidefinite).
 pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
-    let t = p.vec3(
-        "vessel",
-        "damping_translational",
-        None,
-        "kg/s",
-        Range::NonNegative,
-    )?;
-    let r = p.vec3(
-        "vessel",
-        "damping_rotational",
-        None,
-        "kg m^2/s",
-        Range::NonNegative,
-    )?;
-    Ok(Some(Arc::new(Damping {
-        translational: t.into(),
-        rotational: r.into(),
-    })))
+    let matrix = read_matrix(p)?;
+    let coupled = matrix.fixed_view::<3, 3>(0, 3).amax() > 0.0
+        || matrix.fixed_view::<3, 3>(3, 0).amax() > 0.0;
+    Ok(Some(Arc::new(Damping { matrix, coupled })))
 }
 
 const ACCOUNTS: [Account; 1] = [Account {
@@ -53,9 +133,10 @@ impl Force for Damping {
         &ACCOUNTS
     }
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
-        // −D ν with ν = M⁻¹ u: −Dt/mv on p, −Dr T⁻¹ on m.
-        let fu_t = Matrix3::from_diagonal(&(self.translational * (-1.0 / fr.body.mass)));
-        let fu_r = Matrix3::from_diagonal(&(-self.rotational.component_mul(&fr.body.inertia_inv)));
+        // −D ν with ν = M⁻¹ u, within each block system: −D_tt/mv on p, −D_rr T⁻¹ on m.
+        let [dtt, _, _, drr] = self.blocks();
+        let fu_t = -dtt / fr.body.mass;
+        let fu_r = -drr * Matrix3::from_diagonal(&fr.body.inertia_inv);
         b.force(
             Sys::Trans,
             Some(0),
@@ -72,5 +153,16 @@ impl Force for Damping {
                 ..Rows::ZERO
             },
         );
+    }
+    fn forced(&self) -> bool {
+        self.coupled
+    }
+    /// The couplings between the block systems: `−D_tr ω` on the force, `−D_rt v` on the moment.
+    fn add_forcing(&self, fr: &Frozen, _t: f64, z: &[Z3; 2], g: &mut Forcing) {
+        let [_, dtr, drt, _] = self.blocks();
+        let v: Vector3<f64> = z[0][0] / fr.body.mass;
+        let w = z[1][0].component_mul(&fr.body.inertia_inv);
+        g.force(Sys::Trans, Some(0), -dtr * w);
+        g.force(Sys::Rot, Some(0), -drt * v);
     }
 }
