@@ -162,6 +162,10 @@ def test_the_compiled_dop853_peer_matches_the_independent_model():
     assert errs[2] < 1e-8 and errs[0] > errs[1] > errs[2], errs
     with pytest.raises(phsplit.InvalidInputError, match="t_span"):
         f.solve_dop853((5.0, 1.0), y0, 1e-6, np.array([1e-9]))
+    bad = y0.copy()
+    bad[4] = np.nan
+    with pytest.raises(phsplit.InvalidInputError, match="entry 4"):
+        f.solve_dop853((0.0, 1.0), bad, 1e-6, np.array([1e-9]))
 
 
 def test_chunked_cli_output_equals_one_simulate_call(tmp_path):

@@ -40,7 +40,8 @@ type M6 = SMatrix<f64, 6, 6>;
 /// The stage system of at most three stages.
 type Stages = SMatrix<f64, 18, 18>;
 
-/// Most Newton iterations per step.
+/// Most Newton iterations (and fixed-point passes of the attitude) per step. Newton's method
+/// converges for `h|ω|` up to about 1; longer steps give `None`.
 const MAX_NEWTON: usize = 30;
 
 /// Kirchhoff's equations for a mass matrix `M` (stored as `M⁻¹`).
@@ -54,7 +55,10 @@ impl Kirchhoff {
     /// symmetric to 1e-12 relative, and the smallest eigenvalue positive).
     pub fn new(m: &M6) -> Result<Self> {
         let scale = m.amax();
-        if !(scale.is_finite() && scale > 0.0) || (m - m.transpose()).amax() > 1e-12 * scale {
+        if !m.iter().all(|x| x.is_finite())
+            || scale <= 0.0
+            || (m - m.transpose()).amax() > 1e-12 * scale
+        {
             return Err(Error::InvalidInput(
                 "the mass matrix M must be symmetric and finite".into(),
             ));
@@ -125,6 +129,9 @@ impl Kirchhoff {
     /// One step of length `h` with `s` Gauss stages (1 to 3; order `2s`): the momenta `u` and
     /// the attitude `q`. `None` if Newton's method does not converge (a step far too long).
     pub fn flow(&self, u0: &V6, q0: &Matrix3<f64>, h: f64, s: usize) -> Option<(V6, Matrix3<f64>)> {
+        if !(1..=3).contains(&s) || !u0.iter().all(|x| x.is_finite()) || !h.is_finite() {
+            return None;
+        }
         let (a, b) = tableau(s);
         // Stages Y_i, from u0.
         let mut y = [*u0; 3];
@@ -162,7 +169,8 @@ impl Kirchhoff {
                 size = size.max(y[i].amax());
                 step = step.max(d.amax());
             }
-            if !step.is_finite() {
+            // f64::max drops NaN: check the update itself.
+            if !dy.iter().all(|x| x.is_finite()) {
                 return None;
             }
             if step <= 2.0 * f64::EPSILON * size.max(f64::MIN_POSITIVE) {
@@ -198,6 +206,7 @@ impl Kirchhoff {
                 om[i] += w[j] * (h * a[i][j]);
             }
         }
+        let mut attitude_converged = false;
         for _ in 0..MAX_NEWTON {
             let d: [Vector3<f64>; 3] = std::array::from_fn(|j| dexpinv_neg(&om[j], &w[j]));
             let mut change: f64 = 0.0;
@@ -212,8 +221,14 @@ impl Kirchhoff {
                 om[i] = o;
             }
             if change <= 2.0 * f64::EPSILON * size.max(f64::MIN_POSITIVE) {
+                attitude_converged = true;
                 break;
             }
+        }
+        // The attitude's stage equations contract at the rate `h|ω|/2`: a step too long for
+        // them is refused, not returned unconverged.
+        if !attitude_converged {
+            return None;
         }
         let mut omega = Vector3::zeros();
         for j in 0..s {
@@ -406,6 +421,22 @@ mod tests {
             assert!(e < last / 30.0 || e < 1e-12, "n = {n}: {e} after {last}");
             last = e;
         }
+    }
+
+    #[test]
+    fn non_finite_inputs_and_steps_too_long_give_none() {
+        let k = Kirchhoff::new(&coupled_mass()).unwrap();
+        let (u0, q0) = start();
+        let mut bad = u0;
+        bad[2] = f64::NAN;
+        assert!(k.flow(&bad, &q0, 0.5, 2).is_none());
+        assert!(k.flow(&u0, &q0, 0.5, 4).is_none());
+        // Far beyond h|ω| ~ 1: refused rather than returned unconverged.
+        let fast = u0 * 200.0;
+        assert!(k.flow(&fast, &q0, 50.0, 2).is_none());
+        let mut m = coupled_mass();
+        m[(0, 0)] = f64::NAN;
+        assert!(Kirchhoff::new(&m).is_err());
     }
 
     #[test]

@@ -10,12 +10,12 @@
 //! adds the difference to the relative velocity and books it as the current's work (as for the
 //! linear damping).
 //!
-//! **In flow S2** the force is not affine. Its linearisation at the sub-step's start,
-//! `−c ∘ |ν₀| ∘ ν` (a linear damping with the coefficients `c_i |ν_i(0)| ≥ 0`), is put in the
-//! implicit rows, and the rest, `−c ∘ (|ν| − |ν₀|) ∘ ν`, in the forcing. The two add up to the
+//! **In flow S2** the force is not affine. Its derivative at the sub-step's start,
+//! `−2c ∘ |ν₀| ∘ ν` (a linear damping with the coefficients `2 c_i |ν_i(0)| ≥ 0`), is put in the
+//! implicit rows, and the rest, `−c ∘ (|ν| − 2|ν₀|) ∘ ν`, in the forcing. The two add up to the
 //! force at every state, so the vector field and the collocation solution are the force's own;
 //! the split only keeps the fixed-point iteration of the forcing contractive at long steps (the
-//! rest's derivative is `c |ν − ν₀|`, small over a sub-step). Flow S2 is then Gauss collocation
+//! rest's derivative is `2c ∘ (|ν| − |ν₀|)`, zero at the start and small over a sub-step). Flow S2 is then Gauss collocation
 //! (docs/model.md §3.7), whose energy balance is exact for the quadratic `H`:
 //! `H(1) − H(0) = h Σ b_i P(Y_i)`, with the booked dissipation `h Σ b_i Σ_j c_j |ν_j| ν_j² ≥ 0`
 //! at the stages (positive weights). So flow S2 stays dissipative, and the split keeps its
@@ -98,14 +98,14 @@ impl Force for QuadraticDamping {
     fn accounts(&self) -> &'static [Account] {
         &ACCOUNTS
     }
-    /// The linearisation at the sub-step's start, `−c ∘ |ν₀| ∘ ν`, with `ν = M⁻¹u`.
+    /// The derivative at the sub-step's start, `−2c ∘ |ν₀| ∘ ν`, with `ν = M⁻¹u`.
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
         let minv = [
             Vector3::from_element(1.0 / fr.body.mass),
             fr.body.inertia_inv,
         ];
         for (k, sys) in [Sys::Trans, Sys::Rot].into_iter().enumerate() {
-            let d = self.of(k).component_mul(&fr.velocity[k].abs());
+            let d = self.of(k).component_mul(&fr.velocity[k].abs()) * 2.0;
             b.force(
                 sys,
                 Some(0),
@@ -119,14 +119,14 @@ impl Force for QuadraticDamping {
     fn forced(&self) -> bool {
         true
     }
-    /// The rest, `−c ∘ (|ν| − |ν₀|) ∘ ν`.
+    /// The rest, `−c ∘ (|ν| − 2|ν₀|) ∘ ν`.
     fn add_forcing(&self, fr: &Frozen, _t: f64, z: &[Z3; 2], g: &mut Forcing) {
         let nu = [
             z[0][0] / fr.body.mass,
             z[1][0].component_mul(&fr.body.inertia_inv),
         ];
         for (k, sys) in [Sys::Trans, Sys::Rot].into_iter().enumerate() {
-            let rest = (nu[k].abs() - fr.velocity[k].abs()).component_mul(&nu[k]);
+            let rest = (nu[k].abs() - fr.velocity[k].abs() * 2.0).component_mul(&nu[k]);
             g.force(sys, Some(0), -self.of(k).component_mul(&rest));
         }
     }

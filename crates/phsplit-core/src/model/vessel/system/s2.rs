@@ -13,7 +13,7 @@ use crate::solve::Work;
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// Most fixed-point passes over the forcing of flow S2 in one sub-step.
-const FORCED_MAX_ITERATIONS: usize = 60;
+const FORCED_MAX_ITERATIONS: usize = 200;
 
 /// The stage system of at most three Gauss stages of one 10-dimensional block system.
 type Stages = SMatrix<f64, 30, 30>;
@@ -176,11 +176,18 @@ impl VesselSystem<'_> {
                     omega = (-omega * num / den).clamp(0.05, 2.0);
                 }
             }
+            // Convergence is judged on the residual `G(x) − x` itself, not on the relaxed step
+            // (Aitken's steps do not shrink steadily); a NaN anywhere makes it NaN.
             for k in 0..2 {
                 for i in 0..s {
                     let yi = ys[k][i] + r[k][i] * omega;
                     let size = yi.amax().max(f64::MIN_POSITIVE);
-                    change = change.max((yi - ys[k][i]).amax() / size);
+                    let res = r[k][i].amax() / size;
+                    change = if res.is_nan() || change.is_nan() {
+                        f64::NAN
+                    } else {
+                        change.max(res)
+                    };
                     ys[k][i] = yi;
                     stage_z[i][k] = unpack(&yi, k);
                 }
