@@ -57,7 +57,11 @@ def main() -> None:
     md = read_model_description(str(path))
     unzipped = extract(str(path))
 
-    def run_bare():
+    force = {v.name: v.valueReference for v in md.modelVariables}["external_force.x"]
+
+    def run_loop(changing: bool):
+        """doStep over the run through FMPy's FMU2Slave; with ``changing``, a new external force
+        before every step, as a coupling gives it. Returns the final position.x."""
         s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
                       instanceName="v")
         s.instantiate()
@@ -65,34 +69,21 @@ def main() -> None:
         s.enterInitializationMode()
         s.exitInitializationMode()
         for k in range(n):
+            if changing:
+                s.setReal([force], [1e5 * np.sin(0.05 * k * dt)])
             s.doStep(k * dt, dt)
         x = s.getReal([0])[0]
         s.terminate()
         s.freeInstance()
         return x
 
-    force = {v.name: v.valueReference for v in md.modelVariables}["external_force.x"]
-
-    def run_changing():
-        s = FMU2Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier,
-                      instanceName="v")
-        s.instantiate()
-        s.setupExperiment(startTime=0.0)
-        s.enterInitializationMode()
-        s.exitInitializationMode()
-        for k in range(n):
-            s.setReal([force], [1e5 * np.sin(0.05 * k * dt)])  # a new input every step, as a coupling gives
-            s.doStep(k * dt, dt)
-        s.terminate()
-        s.freeInstance()
-
     def run_simulate():
         return phsplit.simulate(phsplit.Vessel.paper(), method="sp4", h=dt, t_span=(0.0, t_end))
 
     t_fmpy, r = best(run_fmpy, args.repeat)
-    t_bare, x_bare = best(run_bare, args.repeat)
+    t_bare, x_bare = best(lambda: run_loop(False), args.repeat)
     t_sim, sol = best(run_simulate, args.repeat)
-    t_changing, _ = best(run_changing, args.repeat)
+    t_changing, _ = best(lambda: run_loop(True), args.repeat)
     # The same numbers (the FMU test asserts this; here a guard that the runs are the same run).
     diff = abs(r["position.x"][-1] - sol.x[-1, 0]) / abs(sol.x[-1, 0])
     assert diff < 1e-12 and abs(x_bare - sol.x[-1, 0]) < 1e-9 * abs(sol.x[-1, 0]), diff
