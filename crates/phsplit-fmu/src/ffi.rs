@@ -1,4 +1,4 @@
-//! The FMI 2.0 co-simulation C API over [`crate::model`].
+//! The FMI 2.0 co-simulation C API over [`crate::instance`] and [`crate::layout`].
 //!
 //! The types and signatures follow the standard's headers `fmi2TypesPlatform.h` and
 //! `fmi2FunctionTypes.h` (FMI 2.0.4, Modelica Association, 2-clause BSD), written out here: the
@@ -17,7 +17,8 @@
 //! states from `fmi2GetFMUstate`). Null pointers are checked and refused.
 #![allow(clippy::missing_safety_doc)]
 
-use crate::model::{Instance, Layout, Mode, Val};
+use crate::instance::{Instance, Mode};
+use crate::layout::{Layout, Val};
 use std::ffi::{c_char, c_int, c_uint, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::Arc;
