@@ -457,8 +457,8 @@ impl Instance {
             "position" => s.x[i],
             "euler" => s.euler()[i],
             "quaternion" => so3::quaternion(&s.q)[i],
-            "velocity" => s.p[i] / body.mass,
-            "angular_velocity" => s.m[i] * body.inertia_inv[i],
+            "velocity" => body.velocity(&s.p, &s.m)[0][i],
+            "angular_velocity" => body.velocity(&s.p, &s.m)[1][i],
             "control_force" | "control_moment" => {
                 let sys = VesselSystem::new(&r.vessel, r.settings.control_start);
                 let on = sys.control_on(self.time);

@@ -106,6 +106,12 @@ impl PyVessel {
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         from_toml(py, &Value::Table(self.inner.params.clone()))
     }
+    /// The 6×6 mass matrix `M = M_RB + M_A` (kg, kg m, kg m^2 blocks; body frame, z up) as
+    /// rows: the momenta are `(p, m) = M ν`.
+    fn mass_matrix(&self) -> Vec<Vec<f64>> {
+        let m = &self.inner.body.mass_matrix;
+        (0..6).map(|i| (0..6).map(|j| m[(i, j)]).collect()).collect()
+    }
     /// The names of the vessel's components, in the order they are assembled.
     fn components(&self) -> Vec<&'static str> {
         self.inner.forces.iter().map(|f| f.name()).collect()

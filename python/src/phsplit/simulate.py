@@ -78,6 +78,12 @@ class Vessel:
         """The vessel's force components (ports), in the order they are assembled."""
         return self._inner.components()
 
+    @property
+    def mass_matrix(self) -> np.ndarray:
+        """The 6x6 mass matrix ``M = M_RB + M_A`` (body frame, z up; kg, kg m, kg m^2 blocks):
+        the momenta are ``(p, m) = M nu`` (docs/model.md §5.14)."""
+        return np.asarray(self._inner.mass_matrix(), dtype=float)
+
     def natural_periods(self, control: bool = True, **initial: Sequence[float]) -> list[float]:
         """The natural periods (s, ascending) of the vessel's oscillating modes, flow S2
         linearised at the initial attitude (or at ``initial_state(**initial)``'s), with the
@@ -266,15 +272,27 @@ class Solution:
         """The events found (``phsplit.events.EventHit``: name, t, state, terminal), in order."""
         return list(self.meta.get("events", []))
 
+    def _velocities(self) -> np.ndarray:
+        """The body velocities ``nu = M^-1 (p, m)`` (N, 6), with the vessel's mass matrix."""
+        u = np.hstack([np.atleast_2d(self.p), np.atleast_2d(self.m)])
+        M = self.meta.get("mass_matrix")
+        if M is None:
+            return u / np.concatenate([[self.meta["mass"]] * 3, np.asarray(self.meta["inertia"])])
+        M = np.asarray(M, dtype=float)
+        d = np.diag(M)
+        if not np.any(M - np.diag(d)):
+            return u / d
+        return np.linalg.solve(M, u.T).T
+
     @property
     def v(self) -> np.ndarray:
-        """Body linear velocity (N, 3), m/s."""
-        return self.p / self.meta["mass"]
+        """Body linear velocity (N, 3), m/s (``nu = M^-1 (p, m)``)."""
+        return self._velocities()[:, :3]
 
     @property
     def w(self) -> np.ndarray:
-        """Body angular velocity (N, 3), rad/s."""
-        return self.m / np.asarray(self.meta["inertia"])
+        """Body angular velocity (N, 3), rad/s (``nu = M^-1 (p, m)``)."""
+        return self._velocities()[:, 3:]
 
     def state(self, i: int = -1) -> np.ndarray:
         """The flat 27-vector state at saved index ``i`` (p, m, Q column-major, mu, x, phi_th,
@@ -627,7 +645,8 @@ def simulate(
         orthogonality_defect=raw["orthogonality_defect"], status=raw["status"],
         method=info["name"], h=used["h"], control_start=used["control_start"], steps=raw["steps"],
         failure=raw.get("failure"), last_good_state=raw["last_good"],
-        meta={"mass": body["mass"], "inertia": body["inertia"], "t_last_good": raw["t_last_good"],
+        meta={"mass": body["mass"], "inertia": body["inertia"], "mass_matrix": vessel.mass_matrix,
+              "t_last_good": raw["t_last_good"],
               "components": vessel.components},
         account_force=raw["account_force"], account_moment=raw["account_moment"], settings=dict(used),
         outputs={k: (u, ln, np.asarray(v)) for k, (u, ln, v) in raw.get("outputs", {}).items()},

@@ -33,12 +33,16 @@ where
 /// The `e^{−Āᵀτ}` block grows where `Ā` dissipates, so for long steps the exponential is taken
 /// over `τ = h/2^k` with `‖Ā τ‖₁ ≤ 1`, and doubled back up with `Z(2τ) = Z(τ) + Φ Z(τ) Φᵀ`,
 /// `Φ(2τ) = Φ(τ)²` (the second half of the interval starts from `Φ z0`).
-pub fn flow_and_gramian(
-    abar: &SMatrix<f64, 10, 10>,
-    z0: &SVector<f64, 10>,
+pub fn flow_and_gramian<const N: usize, const N2: usize>(
+    abar: &SMatrix<f64, N, N>,
+    z0: &SVector<f64, N>,
     h: f64,
-) -> (SMatrix<f64, 10, 10>, SMatrix<f64, 10, 10>) {
-    let norm1 = (0..10)
+) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>)
+where
+    Const<N2>: DimMin<Const<N2>, Output = Const<N2>>,
+{
+    assert_eq!(N2, 2 * N, "the Van Loan exponential is twice the system's size");
+    let norm1 = (0..N)
         .map(|j| abar.column(j).iter().map(|v| v.abs()).sum::<f64>())
         .fold(0.0, f64::max)
         * h.abs();
@@ -48,15 +52,15 @@ pub fn flow_and_gramian(
         0
     };
     let tau = h / 2f64.powi(k);
-    let mut c = SMatrix::<f64, 20, 20>::zeros();
-    c.fixed_view_mut::<10, 10>(0, 0).copy_from(&(abar * tau));
-    c.fixed_view_mut::<10, 10>(0, 10)
+    let mut c = SMatrix::<f64, N2, N2>::zeros();
+    c.fixed_view_mut::<N, N>(0, 0).copy_from(&(abar * tau));
+    c.fixed_view_mut::<N, N>(0, N)
         .copy_from(&(z0 * z0.transpose() * tau));
-    c.fixed_view_mut::<10, 10>(10, 10)
+    c.fixed_view_mut::<N, N>(N, N)
         .copy_from(&(-abar.transpose() * tau));
     let e = c.exp();
-    let mut phi: SMatrix<f64, 10, 10> = e.fixed_view::<10, 10>(0, 0).into_owned();
-    let f12: SMatrix<f64, 10, 10> = e.fixed_view::<10, 10>(0, 10).into_owned();
+    let mut phi: SMatrix<f64, N, N> = e.fixed_view::<N, N>(0, 0).into_owned();
+    let f12: SMatrix<f64, N, N> = e.fixed_view::<N, N>(0, N).into_owned();
     let mut z = f12 * phi.transpose();
     for _ in 0..k {
         z += phi * z * phi.transpose();
@@ -66,7 +70,7 @@ pub fn flow_and_gramian(
 }
 
 /// `tr(M Z)` for symmetric `M`: the integral `∫ zᵀ M z ds` given the Gramian `Z`.
-pub fn trace_product(m: &SMatrix<f64, 10, 10>, z: &SMatrix<f64, 10, 10>) -> f64 {
+pub fn trace_product<const N: usize>(m: &SMatrix<f64, N, N>, z: &SMatrix<f64, N, N>) -> f64 {
     m.component_mul(z).sum()
 }
 
@@ -147,7 +151,7 @@ pub(crate) mod tests {
         let z0 = SVector::<f64, 10>::from_fn(|i, _| if i == 9 { 1.0 } else { (i as f64).sin() });
         let m = SMatrix::<f64, 10, 10>::from_fn(|i, j| 1.0 / (1.0 + i as f64 + j as f64));
         let h = 0.8;
-        let (f, z) = flow_and_gramian(&a, &z0, h);
+        let (f, z) = flow_and_gramian::<10, 20>(&a, &z0, h);
         let (f2, [g]) = flow_with_integrals(&a, &[m], h);
         assert!((f - f2).norm() < 1e-13);
         let via_gramian = trace_product(&m, &z);
@@ -162,7 +166,7 @@ pub(crate) mod tests {
         let z0 = SVector::<f64, 10>::from_fn(|i, _| if i == 9 { 1.0 } else { 1.0 + i as f64 });
         let m = SMatrix::<f64, 10, 10>::from_fn(|i, j| if i == j && i < 9 { 1.0 } else { 0.0 });
         let h = 20.0;
-        let (f, z) = flow_and_gramian(&a, &z0, h);
+        let (f, z) = flow_and_gramian::<10, 20>(&a, &z0, h);
         assert!((f - flow(&a, h)).norm() < 1e-12 * flow(&a, h).norm());
         let n = 40000;
         let step = flow(&a, h / n as f64);

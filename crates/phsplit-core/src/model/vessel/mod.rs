@@ -1,21 +1,24 @@
 //! The vessel under dynamic-positioning control (paper §3.4, eqs. 29–41; docs/model.md §2).
 //!
 //! Body-frame velocities `v` (linear) and `w` (angular), attitude `Q` (body → spatial), spatial
-//! position `x` (z up). The vessel is a rigid body ([`Body`]: mass and principal inertias)
-//! with forces and ports as components ([`forces`]), a default initial state ([`Initial`]),
-//! and the dynamical system built from them for a run ([`system::VesselSystem`]).
+//! position `x` (z up). The vessel is a rigid body in a fluid ([`Body`]: its 6×6 mass matrix
+//! `M = M_RB + M_A`, the paper's `diag(mv, mv, mv, T)` or general) with forces and ports as
+//! components ([`forces`]), a default initial state ([`Initial`]), and the dynamical system
+//! built from them for a run ([`system::VesselSystem`]).
 //!
-//! Energy (eq. 35): `H = ½ mᵀT⁻¹m + ½|p|²/mv + Σ` the components' stores (the restoring
+//! Energy (eq. 35): `H = ½ uᵀM⁻¹u` (`u = (p, m)`; the paper's `½ mᵀT⁻¹m + ½|p|²/mv`) `+ Σ` the
+//! components' stores (the restoring
 //! forces': `½ muᵀG⁺mu + ½ c x_z²`). The forces' power is booked per component in the ledger,
 //! so that `dH/dt = Σ port power − Σ dissipation`.
 
+pub mod body;
 pub mod forces;
 pub mod params;
 pub mod state;
 pub mod system;
 
+pub use body::Body;
 use crate::error::Result;
-use crate::flows::rigid_body::FreeRigidBody;
 use crate::lie::so3;
 use forces::Force;
 use nalgebra::Vector3;
@@ -26,38 +29,6 @@ pub use system::{LinearFlow, VesselSystem};
 
 /// The paper's vessel (Appendix D, as restated in docs/model.md §4), as TOML.
 pub const PAPER_VESSEL_TOML: &str = include_str!("../../../data/paper_vessel.toml");
-
-/// The rigid body: mass and principal inertias (keys `vessel.mass`, `vessel.inertia`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Body {
-    /// `mv`, kg.
-    pub mass: f64,
-    /// `T = diag(T1, T2, T3)` roll, pitch, yaw, kg m².
-    pub inertia: Vector3<f64>,
-    /// `T⁻¹`.
-    pub inertia_inv: Vector3<f64>,
-    /// The free rigid body of flow S1.
-    pub free: FreeRigidBody,
-}
-
-impl Body {
-    fn read(p: &mut Params) -> Result<Self> {
-        let mass = p.f64("vessel", "mass", "kg", Range::Positive)?;
-        let inertia: Vector3<f64> = p
-            .vec3("vessel", "inertia", None, "kg m^2", Range::Positive)?
-            .into();
-        Ok(Self {
-            mass,
-            inertia,
-            inertia_inv: inertia.map(|v| 1.0 / v),
-            free: FreeRigidBody::new(inertia)?,
-        })
-    }
-    /// Kinetic energy `½ mᵀT⁻¹m + ½|p|²/mv`, J.
-    pub fn kinetic_energy(&self, s: &VesselState) -> f64 {
-        self.free.kinetic_energy(&s.m) + 0.5 * s.p.norm_squared() / self.mass
-    }
-}
 
 /// The default initial state, in engineering variables (table `[initial]`).
 #[derive(Debug, Clone, PartialEq)]
@@ -192,9 +163,9 @@ impl Vessel {
         self.forces.iter().find(|f| f.name() == name)
     }
 
-    /// The state from engineering variables: attitude from ZYX Euler angles, `p = mv v`,
-    /// `m = T w`, the components' own states consistent with them (`mu = G Qᵀe3`), integral
-    /// states zero.
+    /// The state from engineering variables: attitude from ZYX Euler angles, momenta
+    /// `(p, m) = M ν`, the components' own states consistent with them (`mu = G Qᵀe3`),
+    /// integral states zero.
     pub fn state_from(
         &self,
         euler: Vector3<f64>,
@@ -203,9 +174,10 @@ impl Vessel {
         angular_velocity: Vector3<f64>,
     ) -> VesselState {
         let z = Vector3::zeros();
+        let [p, m] = self.body.momentum(&velocity, &angular_velocity);
         let mut s = VesselState {
-            p: velocity * self.body.mass,
-            m: angular_velocity.component_mul(&self.body.inertia),
+            p,
+            m,
             q: so3::from_euler_zyx(&euler),
             mu: z,
             x: position,

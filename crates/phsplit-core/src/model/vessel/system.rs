@@ -187,9 +187,8 @@ impl<'a> VesselSystem<'a> {
 
     /// The frozen view of a sub-step that starts at `s`.
     fn frozen(&self, s: &VesselState, on: bool) -> Frozen<'_> {
-        let b = &self.vessel.body;
         let mut fr = self.frozen_at(&s.q, on);
-        fr.velocity = [s.p / b.mass, s.m.component_mul(&b.inertia_inv)];
+        fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
         fr
     }
 
@@ -219,12 +218,14 @@ impl<'a> VesselSystem<'a> {
     /// Flow S2 at the frozen view `fr` ([`Self::s2_at`]).
     fn s2_of(&self, fr: &Frozen, ledger: bool) -> S2Builder {
         let mut b = S2Builder::new(ledger);
-        // The kinematics of the position, x' = Q v = Q p / mv: the body's, not a force's.
-        b.rows(Sys::Trans).avu = fr.q * (1.0 / self.vessel.body.mass);
+        // The kinematics of the position, x' = Q v: the body's, not a force's.
+        b.rate_v(Sys::Trans, Sys::Trans, &fr.q);
         for (f, base) in self.vessel.forces.iter().zip(&self.bases) {
             b.base = *base;
             f.add_s2(fr, &mut b);
         }
+        let body = &self.vessel.body;
+        b.finish(&body.minv_blocks, body.is_diagonal());
         b
     }
 
@@ -237,22 +238,17 @@ impl<'a> VesselSystem<'a> {
     /// A step far beyond the shortest of them cannot resolve the motion (docs/model.md §4).
     pub fn natural_periods(&self, q: &Matrix3<f64>, on: bool) -> Vec<f64> {
         let b = self.s2_at(q, on, false);
+        // The 18×18 system (the two block systems and what couples them), without the
+        // constant column.
+        let full = s2::augmented(&b);
+        let a: nalgebra::SMatrix<f64, 18, 18> = full.fixed_view::<18, 18>(0, 0).into_owned();
         let mut out = Vec::new();
-        for blk in &b.sys {
-            let mut a = nalgebra::SMatrix::<f64, 9, 9>::zeros();
-            a.fixed_view_mut::<3, 3>(0, 0).copy_from(&blk.auu);
-            a.fixed_view_mut::<3, 3>(0, 3).copy_from(&blk.auv);
-            a.fixed_view_mut::<3, 3>(0, 6).copy_from(&blk.auw);
-            a.fixed_view_mut::<3, 3>(3, 0).copy_from(&blk.avu);
-            a.fixed_view_mut::<3, 3>(6, 3).copy_from(&blk.awv);
-            // Balance by the momentum scale (u = M v): the raw entries span many decades.
-            let scale = a.abs().max().max(f64::MIN_POSITIVE);
-            let Some(ev) = (a / scale)
-                .try_schur(1e-15, 10_000)
-                .map(|s| s.complex_eigenvalues())
-            else {
-                continue;
-            };
+        // Balance by the momentum scale (u = M v): the raw entries span many decades.
+        let scale = a.abs().max().max(f64::MIN_POSITIVE);
+        if let Some(ev) = (a / scale)
+            .try_schur(1e-15, 10_000)
+            .map(|s| s.complex_eigenvalues())
+        {
             for l in ev.iter() {
                 let (re, im) = (l.re * scale, l.im * scale);
                 let r = re.hypot(im);
@@ -279,10 +275,10 @@ impl<'a> VesselSystem<'a> {
         s.phi_th = z[1][2];
     }
 
-    /// `M⁻¹` on the momentum of each block system (diagonal).
+    /// The diagonal of `M⁻¹` on the momentum of each block system (`M` of the paper's form).
     fn minv(&self) -> [Vector3<f64>; 2] {
-        let b = &self.vessel.body;
-        [Vector3::from_element(1.0 / b.mass), b.inertia_inv]
+        let b = &self.vessel.body.minv_blocks;
+        [b[0][0].diagonal(), b[1][1].diagonal()]
     }
 
     fn sign(&self, k: usize) -> f64 {
@@ -294,14 +290,12 @@ impl<'a> VesselSystem<'a> {
 
     /// Power per account at block states `z`, from the booked rows: `±(M⁻¹u)·f`.
     fn power_at(&self, booked: &[[Rows; 2]; MAX_ACCOUNTS], z: &[Z3; 2]) -> Work {
-        let minv = self.minv();
+        let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
         let mut w = Work::default();
         for k in 0..self.accounts.len() {
             let mut p = 0.0;
             for sys in 0..2 {
-                p += z[sys][0]
-                    .component_mul(&minv[sys])
-                    .dot(&booked[k][sys].at(&z[sys]));
+                p += nu[sys].dot(&booked[k][sys].at(&nu, &z[sys]));
             }
             w.0[k] = self.sign(k) * p;
         }
@@ -314,10 +308,10 @@ impl<'a> VesselSystem<'a> {
         let z = Vector3::zeros();
         match which {
             Flow::S1 => {
-                let w = self.vessel.body.free.omega(&s.m);
+                let (dp, dm, w) = self.s1_rates(s);
                 VesselState {
-                    p: -w.cross(&s.p),
-                    m: -w.cross(&s.m),
+                    p: dp,
+                    m: dm,
                     q: s.q * so3::hat(&w),
                     mu: z,
                     x: z,
@@ -330,6 +324,13 @@ impl<'a> VesselSystem<'a> {
                 let b = self.s2_of(&view, false);
                 let zs = self.blocks_of(s);
                 let [mut ft, mut fr] = [b.sys[0].field(&zs[0]), b.sys[1].field(&zs[1])];
+                if let Some(c) = &b.cross {
+                    // What each system takes from the other's momentum.
+                    ft[0] += c[0][0] * zs[1][0];
+                    ft[1] += c[0][1] * zs[1][0];
+                    fr[0] += c[1][0] * zs[0][0];
+                    fr[1] += c[1][1] * zs[0][0];
+                }
                 if self.forced {
                     let g = self.forcing(&view, t, &zs);
                     for i in 0..3 {
@@ -354,11 +355,24 @@ impl<'a> VesselSystem<'a> {
     /// attitude.
     pub fn vector_field(&self, s: &VesselState, t: f64, on: bool) -> VesselState {
         let mut d = self.split_field(s, t, on, Flow::S2);
-        let w = self.vessel.body.free.omega(&s.m);
-        d.p -= w.cross(&s.p);
-        d.m -= w.cross(&s.m);
+        let (dp, dm, w) = self.s1_rates(s);
+        d.p += dp;
+        d.m += dm;
         d.q = s.q * so3::hat(&w);
         d
+    }
+
+    /// Flow S1's momentum rates and the angular velocity: Kirchhoff's `p' = p × ω`,
+    /// `m' = m × ω + p × v` (docs/model.md §3.8), which for `M` of the paper's form is the free
+    /// rigid body's `m' = m × ω` with `p` carried along (`p × v = 0`).
+    fn s1_rates(&self, s: &VesselState) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let body = &self.vessel.body;
+        if body.is_diagonal() {
+            let w = body.free.omega(&s.m);
+            return (-w.cross(&s.p), -w.cross(&s.m), w);
+        }
+        let [v, w] = body.velocity(&s.p, &s.m);
+        (s.p.cross(&w), s.m.cross(&w) + s.p.cross(&v), w)
     }
 
     /// The power per account at `s` and time `t` (W).
@@ -376,12 +390,12 @@ impl<'a> VesselSystem<'a> {
 
     /// The power per account of the forcing `g` at block states `z`: `±(M⁻¹u)·f`.
     fn forcing_power(&self, g: &Forcing, z: &[Z3; 2]) -> Work {
-        let minv = self.minv();
+        let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
         let mut w = Work::default();
         for k in 0..self.accounts.len() {
             let mut p = 0.0;
             for sys in 0..2 {
-                p += z[sys][0].component_mul(&minv[sys]).dot(&g.booked[k][sys]);
+                p += nu[sys].dot(&g.booked[k][sys]);
             }
             w.0[k] = self.sign(k) * p;
         }
@@ -411,20 +425,47 @@ impl<'a> VesselSystem<'a> {
         let b = self.s2_of(&fr, true);
         let booked = b.booked.expect("built with the ledger");
         let z = self.blocks_of(s);
+        let nu = self.vessel.body.velocity(&s.p, &s.m);
         let g = self.forcing(&fr, t, &z);
         (0..self.accounts.len())
             .map(|k| {
                 (
-                    booked[k][0].at(&z[0]) + g.booked[k][0],
-                    booked[k][1].at(&z[1]) + g.booked[k][1],
+                    booked[k][0].at(&nu, &z[0]) + g.booked[k][0],
+                    booked[k][1].at(&nu, &z[1]) + g.booked[k][1],
                 )
             })
             .collect()
     }
 
-    /// Exact flow S1 over `h`: the free rigid body with a Magnus attitude of the given order
-    /// (paper §3.4.1). `p(h) = Q(h)ᵀ Q0 p0`; `mu, x, phi` unchanged.
+    /// Flow S1 over `h` (paper §3.4.1; docs/model.md §3.8); `mu, x, phi` unchanged. For `M` of
+    /// the paper's form, exact: the free rigid body with a Magnus attitude of the given order,
+    /// `p(h) = Q(h)ᵀ Q0 p0`. For a general `M`, Kirchhoff's equations by Gauss collocation of the
+    /// same order (H kept to round-off) with the attitude by Runge–Kutta–Munthe-Kaas; where
+    /// that does not converge (a step far too long for the rotation) the state becomes NaN and
+    /// the run stops with what it had.
     pub fn flow_s1(&self, s: &mut VesselState, h: f64, order: MagnusOrder) {
+        if let Some(k) = &self.vessel.body.kirchhoff {
+            let stages = match order {
+                MagnusOrder::Two => 1,
+                MagnusOrder::Four => 2,
+                MagnusOrder::Six => 3,
+            };
+            let mut u = nalgebra::SVector::<f64, 6>::zeros();
+            u.fixed_rows_mut::<3>(0).copy_from(&s.p);
+            u.fixed_rows_mut::<3>(3).copy_from(&s.m);
+            match k.flow(&u, &s.q, h, stages) {
+                Some((u1, q1)) => {
+                    s.p = u1.fixed_rows::<3>(0).into_owned();
+                    s.m = u1.fixed_rows::<3>(3).into_owned();
+                    s.q = q1;
+                }
+                None => {
+                    s.p = Vector3::from_element(f64::NAN);
+                    s.m = s.p;
+                }
+            }
+            return;
+        }
         let (m1, q1) = self.vessel.body.free.flow(&s.m, &s.q, h, order);
         s.p = q1.transpose() * (s.q * s.p);
         s.m = m1;
@@ -810,7 +851,7 @@ mod tests {
                 .position(|a| a.name == "external")
                 .unwrap();
             let vel = s.p / v.body.mass;
-            let w = s.m.component_mul(&v.body.inertia_inv);
+            let w = s.m.component_div(&v.body.inertia);
             let expect = vel.dot(&fb) + w.dot(&(mb + r.cross(&fb)));
             assert!((sys.power(&s, 0.0, false).0[k] - expect).abs() < 1e-12 * expect.abs());
             let ext = v.force("external").unwrap();
@@ -860,7 +901,7 @@ mod tests {
             let c_t = Vector3::new(4e3, 1.75e5, 2e5);
             let c_r = Vector3::new(3e8, 4e9, 2e10);
             let vel = s.p / v.body.mass;
-            let w = s.m.component_mul(&v.body.inertia_inv);
+            let w = s.m.component_div(&v.body.inertia);
             let vc = if current { s.q.transpose() * Vector3::new(0.6, -0.8, 0.0) } else { Vector3::zeros() };
             let vr = vel - vc;
             let ft = -c_t.component_mul(&vr.abs()).component_mul(&vr);

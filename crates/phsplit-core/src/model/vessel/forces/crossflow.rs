@@ -165,25 +165,11 @@ impl Force for CrossflowDrag {
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
         let (dv, dr) = self.diagonal_derivatives(fr.velocity[0].y, fr.velocity[1].z);
         let mut ft = Matrix3::zeros();
-        ft[(1, 1)] = dv / fr.body.mass;
+        ft[(1, 1)] = dv;
         let mut fr_ = Matrix3::zeros();
-        fr_[(2, 2)] = dr * fr.body.inertia_inv.z;
-        b.force(
-            Sys::Trans,
-            Some(0),
-            &Rows {
-                fu: ft,
-                ..Rows::ZERO
-            },
-        );
-        b.force(
-            Sys::Rot,
-            Some(0),
-            &Rows {
-                fu: fr_,
-                ..Rows::ZERO
-            },
-        );
+        fr_[(2, 2)] = dr;
+        b.force(Sys::Trans, Some(0), &Rows::on_velocity(Sys::Trans, ft));
+        b.force(Sys::Rot, Some(0), &Rows::on_velocity(Sys::Rot, fr_));
     }
     fn forced(&self) -> bool {
         true
@@ -191,8 +177,8 @@ impl Force for CrossflowDrag {
     /// The rest: the drag on the body's own velocity less the implicit rows (account 0), and the
     /// current's part, drag on the relative velocity less that (account 1).
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
-        let v = z[0][0].y / fr.body.mass;
-        let r = z[1][0].z * fr.body.inertia_inv.z;
+        let nu = fr.nu(z);
+        let (v, r) = (nu[0].y, nu[1].z);
         let (dv, dr) = self.diagonal_derivatives(fr.velocity[0].y, fr.velocity[1].z);
         let (y, n) = self.load(v, r);
         g.force(Sys::Trans, Some(0), Vector3::new(0.0, y - dv * v, 0.0));

@@ -207,9 +207,8 @@ impl Force for Current {
                 Sys::Trans,
                 Some(0),
                 &Rows {
-                    fu: lin / fr.body.mass,
                     c: c0,
-                    ..Rows::ZERO
+                    ..Rows::on_velocity(Sys::Trans, lin)
                 },
             );
         }
@@ -230,7 +229,7 @@ impl Force for Current {
             // The quadratic damping on the relative velocity: C ∘ (|v| v − |v − v_c| (v − v_c)),
             // less its linearisation at the sub-step's start, which add_s2 puts in the
             // implicit rows.
-            let v = z[0][0] / fr.body.mass;
+            let v = fr.nu(z)[0];
             let (lin, c0) = self.quadratic_linearisation(fr, c);
             let f = quadratic_part(c, &v, &vc);
             g.force(Sys::Trans, Some(0), f - lin * v - c0);

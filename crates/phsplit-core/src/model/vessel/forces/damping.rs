@@ -7,26 +7,23 @@
 //!   sway–yaw couplings `Y_r`, `N_v` of a real hull), checked symmetric (to 1e-12) and positive
 //!   semidefinite (its smallest eigenvalue `≥ −1e-12 max|D|`, else refused naming that eigenvalue).
 //!
-//! Dissipative: the ledger books `νᵀDν ≥ 0` to the account `damping`. In flow S2 the blocks
-//! within translation and within rotation are affine rows (exact flow possible); the couplings
-//! between the two block systems (`D_tr ω` on the force, `D_rt v` on the moment), when nonzero,
-//! are a forcing, linear in the state (Gauss collocation, docs/model.md §3.7), booked to the same
-//! account: at the Gauss stages the account is `h Σ b_i ν_iᵀ D ν_i ≥ 0`, so S2 stays dissipative.
+//! Dissipative: the ledger books `νᵀDν ≥ 0` to the account `damping`. In flow S2 all four blocks
+//! are linear rows on the velocities; the couplings between translation and rotation (`D_tr ω`
+//! on the force, `D_rt v` on the moment), when nonzero, make flow S2 one coupled linear system
+//! (docs/model.md §5.14), still solved exactly or by Gauss collocation, and the account stays
+//! `∫ νᵀDν ≥ 0` (exactly, or `h Σ b_i ν_iᵀ D ν_i ≥ 0` at the Gauss stages).
 
-use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
+use super::{Force, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
-use crate::flows::collocation::Z3;
 use crate::model::vessel::params::{Params, Range};
 use crate::solve::{Account, AccountKind};
-use nalgebra::{Matrix3, SMatrix, Vector3};
+use nalgebra::{Matrix3, SMatrix};
 use std::sync::Arc;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Damping {
     /// `D`, 6×6, body frame: `[[D_tt, D_tr], [D_rt, D_rr]]` on `ν = (v, ω)`.
     pub matrix: SMatrix<f64, 6, 6>,
-    /// Whether `D_tr` or `D_rt` is nonzero (then the couplings are a forcing).
-    coupled: bool,
 }
 
 impl Damping {
@@ -115,9 +112,7 @@ pub fn check_psd(d: &SMatrix<f64, 6, 6>, name: &str) -> crate::Result<()> {
 /// `vessel.damping_matrix` (6×6, symmetric positive semidefinite).
 pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
     let matrix = read_matrix(p)?;
-    let coupled = matrix.fixed_view::<3, 3>(0, 3).amax() > 0.0
-        || matrix.fixed_view::<3, 3>(3, 0).amax() > 0.0;
-    Ok(Some(Arc::new(Damping { matrix, coupled })))
+    Ok(Some(Arc::new(Damping { matrix })))
 }
 
 const ACCOUNTS: [Account; 1] = [Account {
@@ -132,37 +127,15 @@ impl Force for Damping {
     fn accounts(&self) -> &'static [Account] {
         &ACCOUNTS
     }
-    fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
-        // −D ν with ν = M⁻¹ u, within each block system: −D_tt/mv on p, −D_rr T⁻¹ on m.
-        let [dtt, _, _, drr] = self.blocks();
-        let fu_t = -dtt / fr.body.mass;
-        let fu_r = -drr * Matrix3::from_diagonal(&fr.body.inertia_inv);
-        b.force(
-            Sys::Trans,
-            Some(0),
-            &Rows {
-                fu: fu_t,
+    fn add_s2(&self, _fr: &Frozen, b: &mut S2Builder) {
+        // −D ν: −D_tt v − D_tr ω on the force, −D_rt v − D_rr ω on the moment.
+        let [dtt, dtr, drt, drr] = self.blocks();
+        for (sys, [a, b_]) in [(Sys::Trans, [dtt, dtr]), (Sys::Rot, [drt, drr])] {
+            let rows = Rows {
+                fnu: [-a, -b_],
                 ..Rows::ZERO
-            },
-        );
-        b.force(
-            Sys::Rot,
-            Some(0),
-            &Rows {
-                fu: fu_r,
-                ..Rows::ZERO
-            },
-        );
-    }
-    fn forced(&self) -> bool {
-        self.coupled
-    }
-    /// The couplings between the block systems: `−D_tr ω` on the force, `−D_rt v` on the moment.
-    fn add_forcing(&self, fr: &Frozen, _t: f64, z: &[Z3; 2], g: &mut Forcing) {
-        let [_, dtr, drt, _] = self.blocks();
-        let v: Vector3<f64> = z[0][0] / fr.body.mass;
-        let w = z[1][0].component_mul(&fr.body.inertia_inv);
-        g.force(Sys::Trans, Some(0), -dtr * w);
-        g.force(Sys::Rot, Some(0), -drt * v);
+            };
+            b.force(sys, Some(0), &rows);
+        }
     }
 }

@@ -100,19 +100,12 @@ impl Force for QuadraticDamping {
     }
     /// The derivative at the sub-step's start, `−2c ∘ |ν₀| ∘ ν`, with `ν = M⁻¹u`.
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
-        let minv = [
-            Vector3::from_element(1.0 / fr.body.mass),
-            fr.body.inertia_inv,
-        ];
         for (k, sys) in [Sys::Trans, Sys::Rot].into_iter().enumerate() {
             let d = self.of(k).component_mul(&fr.velocity[k].abs()) * 2.0;
             b.force(
                 sys,
                 Some(0),
-                &Rows {
-                    fu: Matrix3::from_diagonal(&(-d.component_mul(&minv[k]))),
-                    ..Rows::ZERO
-                },
+                &Rows::on_velocity(sys, Matrix3::from_diagonal(&(-d))),
             );
         }
     }
@@ -121,10 +114,7 @@ impl Force for QuadraticDamping {
     }
     /// The rest, `−c ∘ (|ν| − 2|ν₀|) ∘ ν`.
     fn add_forcing(&self, fr: &Frozen, _t: f64, z: &[Z3; 2], g: &mut Forcing) {
-        let nu = [
-            z[0][0] / fr.body.mass,
-            z[1][0].component_mul(&fr.body.inertia_inv),
-        ];
+        let nu = fr.nu(z);
         for (k, sys) in [Sys::Trans, Sys::Rot].into_iter().enumerate() {
             let rest = (nu[k].abs() - fr.velocity[k].abs() * 2.0).component_mul(&nu[k]);
             g.force(sys, Some(0), -self.of(k).component_mul(&rest));

@@ -80,11 +80,15 @@ pub enum Sys {
     Rot = 1,
 }
 
-/// A generalised force on the momentum `u` of one block system, affine in its state
-/// `(u, v, w)`: `f = fu u + fv v + fw w + c` (body frame; N or N m).
+/// A generalised force on the momentum `u` of one block system, affine in the body velocities
+/// `ν = (v_t, ω) = M⁻¹u` and in the system's other states `(v, w)`:
+/// `f = F_t v_t + F_r ω + fv v + fw w + c` (body frame; N or N m), with `fnu = [F_t, F_r]`.
+/// A force written on the velocities holds for any mass matrix: the system turns it into rows
+/// on the momenta (and, where `M` or the force couples translation and rotation, into one
+/// coupled system).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Rows {
-    pub fu: Matrix3<f64>,
+    pub fnu: [Matrix3<f64>; 2],
     pub fv: Matrix3<f64>,
     pub fw: Matrix3<f64>,
     pub c: Vector3<f64>,
@@ -92,7 +96,10 @@ pub struct Rows {
 
 impl Rows {
     pub const ZERO: Rows = Rows {
-        fu: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        fnu: [
+            Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        ],
         fv: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
         fw: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
         c: Vector3::new(0.0, 0.0, 0.0),
@@ -101,12 +108,19 @@ impl Rows {
     pub fn constant(c: Vector3<f64>) -> Self {
         Rows { c, ..Self::ZERO }
     }
-    /// The force at a block state.
-    pub fn at(&self, z: &[Vector3<f64>; 3]) -> Vector3<f64> {
-        self.fu * z[0] + self.fv * z[1] + self.fw * z[2] + self.c
+    /// A force linear in the velocity of the system `of` (a damping): `f = F ν_of`.
+    pub fn on_velocity(of: Sys, f: Matrix3<f64>) -> Self {
+        let mut r = Self::ZERO;
+        r.fnu[of as usize] = f;
+        r
+    }
+    /// The force at the velocities `nu` and the block state `z` of its system.
+    pub fn at(&self, nu: &[Vector3<f64>; 2], z: &[Vector3<f64>; 3]) -> Vector3<f64> {
+        self.fnu[0] * nu[0] + self.fnu[1] * nu[1] + self.fv * z[1] + self.fw * z[2] + self.c
     }
     fn add(&mut self, o: &Rows) {
-        self.fu += o.fu;
+        self.fnu[0] += o.fnu[0];
+        self.fnu[1] += o.fnu[1];
         self.fv += o.fv;
         self.fw += o.fw;
         self.c += o.c;
@@ -136,11 +150,32 @@ pub struct Frozen<'a> {
     pub velocity: [Vector3<f64>; 2],
 }
 
+impl Frozen<'_> {
+    /// The body velocities `ν = M⁻¹u` (linear, angular) at the block states `z`.
+    pub fn nu(&self, z: &[Z3; 2]) -> [Vector3<f64>; 2] {
+        self.body.velocity(&z[0][0], &z[1][0])
+    }
+}
+
 /// Flow S2 at a frozen attitude under assembly: the two block systems, and, when the ledger
 /// is kept, each account's force rows.
+///
+/// The components give their forces on the velocities ([`Rows`]) and the rates of their own
+/// states on the velocities ([`S2Builder::rate_v`]); [`S2Builder::finish`] turns them into rows
+/// on the momenta with `ν = M⁻¹u`. Where nothing couples translation and rotation (`M` of the
+/// paper's form and no coupling force) the two block systems stay separate (`sys`, with
+/// `cross = None`); otherwise `cross[k]` holds what system `k`'s rows take from the other
+/// system's momentum, and flow S2 is one coupled system.
 #[derive(Debug, Clone)]
 pub struct S2Builder {
     pub sys: [Blocks; 2],
+    /// Force on `u_k` per velocity `ν_j` (`[k][j]`), before [`Self::finish`].
+    nu_u: [[Matrix3<f64>; 2]; 2],
+    /// Rate of `v_k` per velocity `ν_j`, before [`Self::finish`].
+    nu_v: [[Matrix3<f64>; 2]; 2],
+    /// After [`Self::finish`], when the systems are coupled: for each system `k`, the rows of
+    /// `u_k'` and of `v_k'` on the other system's momentum.
+    pub cross: Option<[[Matrix3<f64>; 2]; 2]>,
     /// Force rows per account and system (only with `ledger`).
     pub booked: Option<Box<[[Rows; 2]; MAX_ACCOUNTS]>>,
     /// First account of the component being assembled.
@@ -160,6 +195,9 @@ impl S2Builder {
         };
         Self {
             sys: [zero; 2],
+            nu_u: [[Matrix3::zeros(); 2]; 2],
+            nu_v: [[Matrix3::zeros(); 2]; 2],
+            cross: None,
             booked: ledger.then(|| Box::new([[Rows::ZERO; 2]; MAX_ACCOUNTS])),
             base: 0,
         }
@@ -168,19 +206,42 @@ impl S2Builder {
     /// (its index in [`Force::accounts`]), or to none (`None`: a conservative exchange between
     /// stores of H, like the restoring forces).
     pub fn force(&mut self, sys: Sys, account: Option<usize>, f: &Rows) {
-        let b = &mut self.sys[sys as usize];
-        b.auu += f.fu;
+        let k = sys as usize;
+        self.nu_u[k][0] += f.fnu[0];
+        self.nu_u[k][1] += f.fnu[1];
+        let b = &mut self.sys[k];
         b.auv += f.fv;
         b.auw += f.fw;
         b.cu += f.c;
-        if let (Some(k), Some(book)) = (account, self.booked.as_mut()) {
-            book[self.base + k][sys as usize].add(f);
+        if let (Some(a), Some(book)) = (account, self.booked.as_mut()) {
+            book[self.base + a][k].add(f);
         }
     }
-    /// The block system `sys`, to add the rows of the states a component drives
-    /// (`v' = A_vu u`, `w' = A_wv v + c_w`).
+    /// Add `r ν_of` to the rate of the second state `v` of `sys` (the position's kinematics,
+    /// the restoring variable `mu`).
+    pub fn rate_v(&mut self, sys: Sys, of: Sys, r: &Matrix3<f64>) {
+        self.nu_v[sys as usize][of as usize] += r;
+    }
+    /// The block system `sys`, to add the rows of the integral states a component drives
+    /// (`w' = A_wv v + c_w`).
     pub fn rows(&mut self, sys: Sys) -> &mut Blocks {
         &mut self.sys[sys as usize]
+    }
+    /// Turn the rows on the velocities into rows on the momenta, `ν = M⁻¹u` with the blocks
+    /// `minv[j][l]` of `M⁻¹`; decide whether the systems are coupled.
+    pub(crate) fn finish(&mut self, minv: &[[Matrix3<f64>; 2]; 2], diagonal: bool) {
+        let on_u = |r: &[Matrix3<f64>; 2], l: usize| r[0] * minv[0][l] + r[1] * minv[1][l];
+        let mut cross = [[Matrix3::zeros(); 2]; 2];
+        let mut coupled = !diagonal;
+        for k in 0..2 {
+            let l = 1 - k;
+            self.sys[k].auu = on_u(&self.nu_u[k], k);
+            self.sys[k].avu = on_u(&self.nu_v[k], k);
+            cross[k] = [on_u(&self.nu_u[k], l), on_u(&self.nu_v[k], l)];
+            coupled |= self.nu_u[k][l].iter().any(|x| *x != 0.0)
+                || self.nu_v[k][l].iter().any(|x| *x != 0.0);
+        }
+        self.cross = coupled.then_some(cross);
     }
 }
 

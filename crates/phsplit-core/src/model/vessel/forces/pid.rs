@@ -262,10 +262,7 @@ impl Pid {
             ..Rows::ZERO
         };
         let d_t = times_diag(&fr.qt, &self.kd_translational) * fr.q;
-        let damp_t = Rows {
-            fu: d_t * (-1.0 / fr.body.mass),
-            ..Rows::ZERO
-        };
+        let damp_t = Rows::on_velocity(Sys::Trans, -d_t);
         // Rotation.
         let (theta, wm) = (fr.euler, fr.w);
         let mut theta_err = theta - self.euler_reference;
@@ -279,10 +276,7 @@ impl Pid {
             ..Rows::ZERO
         };
         let d_r = times_diag(&wt, &self.kd_rotational) * wm;
-        let damp_r = Rows {
-            fu: -times_diag(&d_r, &fr.body.inertia_inv),
-            ..Rows::ZERO
-        };
+        let damp_r = Rows::on_velocity(Sys::Rot, -d_r);
         PidRows {
             port: [port_t, port_r],
             damping: [damp_t, damp_r],
@@ -296,7 +290,9 @@ impl Pid {
         let keep = |rows: &Rows, k: &[usize]| {
             let mut out = Rows::ZERO;
             for &i in k {
-                out.fu.set_row(i, &(rows.fu.row(i)));
+                for j in 0..2 {
+                    out.fnu[j].set_row(i, &(rows.fnu[j].row(i)));
+                }
                 out.fv.set_row(i, &(rows.fv.row(i)));
                 out.fw.set_row(i, &(rows.fw.row(i)));
                 out.c[i] = rows.c[i];
@@ -304,7 +300,7 @@ impl Pid {
             out
         };
         let sum = |a: &Rows, b: &Rows| Rows {
-            fu: a.fu + b.fu,
+            fnu: [a.fnu[0] + b.fnu[0], a.fnu[1] + b.fnu[1]],
             fv: a.fv + b.fv,
             fw: a.fw + b.fw,
             c: a.c + b.c,
@@ -343,13 +339,18 @@ impl Pid {
 
     /// The controller's demand (force, moment; body frame) at block states `z` and time `t`.
     pub fn demand(&self, fr: &Frozen, t: f64, z: &[Z3; 2]) -> (Vector3<f64>, Vector3<f64>) {
-        Self::demand_of(&self.rows(fr), self.moving(fr, t).as_ref(), z)
+        Self::demand_of(&self.rows(fr), self.moving(fr, t).as_ref(), &fr.nu(z), z)
     }
 
     /// The demand from the rows and the moving set point's part, already evaluated.
-    fn demand_of(r: &PidRows, mv: Option<&Moving>, z: &[Z3; 2]) -> (Vector3<f64>, Vector3<f64>) {
-        let mut f = r.port[0].at(&z[0]) + r.damping[0].at(&z[0]);
-        let mut m = r.port[1].at(&z[1]) + r.damping[1].at(&z[1]);
+    fn demand_of(
+        r: &PidRows,
+        mv: Option<&Moving>,
+        nu: &[Vector3<f64>; 2],
+        z: &[Z3; 2],
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let mut f = r.port[0].at(nu, &z[0]) + r.damping[0].at(nu, &z[0]);
+        let mut m = r.port[1].at(nu, &z[1]) + r.damping[1].at(nu, &z[1]);
         if let Some(mv) = mv {
             f += mv.force;
             m += mv.moment;
@@ -492,12 +493,13 @@ impl Force for Pid {
             }
             Some(th) => {
                 let r = self.rows(fr);
-                let (f, m) = Self::demand_of(&r, mv.as_ref(), z);
+                let nu = fr.nu(z);
+                let (f, m) = Self::demand_of(&r, mv.as_ref(), &nu, z);
                 let (force, moment) = th.wrench(&Vector3::new(f.x, f.y, m.z));
                 // What the thrusters deliver, less the affine part already in flow S2.
                 let (rt, rr) = Self::allocated_rows(&r);
-                g.force(Sys::Trans, Some(0), force - rt.at(&z[0]));
-                g.force(Sys::Rot, Some(0), moment - rr.at(&z[1]));
+                g.force(Sys::Trans, Some(0), force - rt.at(&nu, &z[0]));
+                g.force(Sys::Rot, Some(0), moment - rr.at(&nu, &z[1]));
             }
         }
     }

@@ -60,7 +60,7 @@ impl Force for Restoring {
                 ..Rows::ZERO
             },
         );
-        // Roll and pitch: −mu × q3 = hat(q3) mu; mu' = G hat(q3) T⁻¹ m.
+        // Roll and pitch: −mu × q3 = hat(q3) mu; mu' = G hat(q3) ω.
         let hq3 = so3::hat(&fr.q3);
         b.force(
             Sys::Rot,
@@ -70,14 +70,7 @@ impl Force for Restoring {
                 ..Rows::ZERO
             },
         );
-        let tinv = fr.body.inertia_inv;
-        let mut avu = hq3;
-        for i in 0..3 {
-            for j in 0..3 {
-                avu[(i, j)] *= self.g[i] * tinv[j];
-            }
-        }
-        b.rows(Sys::Rot).avu += avu;
+        b.rate_v(Sys::Rot, Sys::Rot, &(Matrix3::from_diagonal(&self.g) * hq3));
     }
     fn storage(&self, s: &VesselState) -> f64 {
         0.5 * s.mu.component_mul(&s.mu).dot(&self.g_plus) + 0.5 * self.heave * s.x.z * s.x.z

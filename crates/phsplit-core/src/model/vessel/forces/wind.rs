@@ -52,8 +52,6 @@ pub struct Wind {
     pub angles: Vec<f64>,
     /// `(C_X, C_Y, C_N)` per angle.
     pub coefficients: Vec<[f64; 3]>,
-    /// The vessel's mass, for `v = p / m`.
-    pub mass: f64,
 }
 
 fn list(
@@ -72,7 +70,7 @@ fn list(
     }
 }
 
-pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
     const T: &str = "wind";
     p.declare(T);
     if !p.has(T) {
@@ -130,7 +128,6 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
         air_density,
         angles: angles.iter().map(|a| a.to_radians()).collect(),
         coefficients: (0..cx.len()).map(|k| [cx[k], cy[k], cn[k]]).collect(),
-        mass: body.mass,
     })))
 }
 
@@ -197,7 +194,7 @@ impl Force for Wind {
         true
     }
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
-        let (f, m) = self.loads(&fr.qt, &(z[0][0] / self.mass), t);
+        let (f, m) = self.loads(&fr.qt, &fr.nu(z)[0], t);
         g.force(Sys::Trans, Some(0), f);
         g.force(Sys::Rot, Some(0), m);
     }
@@ -237,7 +234,6 @@ mod tests {
                 [-0.7, 0.0, 0.0],
                 [0.0, -0.9, -0.05],
             ],
-            mass: 1.0,
         };
         // vessel at rest, heading x: the air flows from bow to stern, γ = 180°.
         let (f, m) = w.loads(&nalgebra::Matrix3::identity(), &Vector3::zeros(), 0.0);
