@@ -102,6 +102,11 @@ impl PyVessel {
     fn paper_toml() -> &'static str {
         PAPER_VESSEL_TOML
     }
+    /// The shipped vessels: (name, description, vessel file text).
+    #[staticmethod]
+    fn presets() -> Vec<(&'static str, &'static str, &'static str)> {
+        phsplit_core::model::vessel::PRESETS.to_vec()
+    }
     /// Every parameter as read (defaults filled in), as a nested dict (SI units).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         from_toml(py, &Value::Table(self.inner.params.clone()))

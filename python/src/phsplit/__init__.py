@@ -50,7 +50,7 @@ from .batch import simulate_many, with_parameters
 from .results import open_dataset, open_sweep, rerun
 from .scenario import Scenario
 from .scenario import load as load_scenario
-from .simulate import Ledger, PassivityWarning, Settings, Solution, StepSizeWarning, Vessel, simulate
+from .simulate import Ledger, PassivityWarning, Settings, Solution, StepSizeWarning, Vessel, presets, simulate
 
 
 def method_info(name: str) -> dict:
@@ -77,6 +77,7 @@ __all__ = [
     "method_info",
     "open_dataset",
     "open_sweep",
+    "presets",
     "rerun",
     "results",
     "rigid_body",

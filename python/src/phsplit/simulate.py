@@ -23,6 +23,11 @@ class PassivityWarning(UserWarning):
     under the condition of the paper's Prop. 2.5, which this run does not meet."""
 
 
+def presets() -> dict[str, tuple[str, str]]:
+    """The shipped vessels: name -> (description with its source, vessel file text)."""
+    return {n: (d, t) for n, d, t in _core.Vessel.presets()}
+
+
 class Vessel:
     """A vessel: rigid body, forces and ports (components), default initial state (SI units).
 
@@ -42,6 +47,20 @@ class Vessel:
     @classmethod
     def paper(cls) -> "Vessel":
         return cls(_core.Vessel.paper(), "paper (Celledoni, Høiseth, Ramzina 2018, App. D)")
+
+    @classmethod
+    def preset(cls, name: str) -> "Vessel":
+        """A shipped vessel by name (``phsplit.presets()`` lists them; ``phsplit vessels``):
+        ``"paper"`` (the paper's, App. D) or ``"osv"`` (the 83 m offshore supply vessel of
+        Fossen's MSS, osv.m: full added mass, CG off the origin). Each number's source is in the
+        preset's file (``phsplit.presets()[name]``)."""
+        found = presets()
+        if not isinstance(name, str) or name not in found:
+            raise _core.InvalidInputError(
+                f"unknown vessel preset {name!r}; the presets are {', '.join(repr(k) for k in found)}")
+        if name == "paper":
+            return cls.paper()
+        return cls(_core.Vessel.from_toml_str(found[name][1]), f"preset {name}")
 
     @classmethod
     def from_toml(cls, path: str | os.PathLike[str]) -> "Vessel":

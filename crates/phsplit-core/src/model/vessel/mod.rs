@@ -30,6 +30,21 @@ pub use system::{LinearFlow, VesselSystem};
 /// The paper's vessel (Appendix D, as restated in docs/model.md §4), as TOML.
 pub const PAPER_VESSEL_TOML: &str = include_str!("../../../data/paper_vessel.toml");
 
+/// The shipped vessels: name, one line on what it is and where its numbers come from, and its
+/// vessel file (each number's source in the file's comments).
+pub const PRESETS: &[(&str, &str, &str)] = &[
+    (
+        "paper",
+        "the paper's vessel (Celledoni, Høiseth, Ramzina 2018, App. D): diagonal M, CG at the origin",
+        PAPER_VESSEL_TOML,
+    ),
+    (
+        "osv",
+        "83 m offshore supply vessel of Fossen's MSS (osv.m): full added mass, CG 4.5 m aft, cross-flow drag",
+        include_str!("../../../data/vessels/osv.toml"),
+    ),
+];
+
 /// The default initial state, in engineering variables (table `[initial]`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Initial {
@@ -151,6 +166,21 @@ impl Vessel {
             }
         }
         t
+    }
+
+    /// A shipped vessel by name ([`PRESETS`]).
+    pub fn preset(name: &str) -> Result<Self> {
+        match PRESETS.iter().find(|p| p.0 == name) {
+            Some((_, _, text)) => Self::from_toml_str(text),
+            None => Err(crate::error::Error::InvalidInput(format!(
+                "unknown vessel preset {name:?}; the presets are {}",
+                PRESETS
+                    .iter()
+                    .map(|p| format!("'{}'", p.0))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))),
+        }
     }
 
     /// The paper's vessel and scenario (docs/model.md §4).
