@@ -358,3 +358,20 @@ CATALOGUE += [
         vessel_with("[control]", "[crossflow_drag]\ndrag_coefficient = 1.0\nx_aft = -36.0\nx_fore = 40.0\n\n[control]"),
         (phsplit.InvalidInputError, phsplit.ScenarioParseError), ("draft",)),
 ]
+
+_ROW = "[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]"
+CATALOGUE += [
+    # issue 18: the general mass matrix and the presets
+    Bad("added mass that is not symmetric",
+        vessel_with("gravity = 9.81", "gravity = 9.81\nadded_mass = [" + ", ".join(
+            [_ROW] + ["[0.0, 0.0, 0.0, 0.0, 0.0, 1.0e6]"] + [_ROW] * 4) + "]"), E,
+        ("vessel.added_mass must be symmetric", "entry [1][5]")),
+    Bad("added mass that makes M indefinite",
+        vessel_with("gravity = 9.81", "gravity = 9.81\nadded_mass = [" + ", ".join(
+            ["[-7.0e6, 0.0, 0.0, 0.0, 0.0, 0.0]"] + [_ROW] * 5) + "]"), E,
+        ("M = M_RB + M_A", "positive definite", "smallest eigenvalue is -")),
+    Bad("added mass with 5 rows", vessel_with("gravity = 9.81", "gravity = 9.81\nadded_mass = [" + ", ".join([_ROW] * 5) + "]"),
+        E, ("6 rows of 6",)),
+    Bad("unknown vessel preset", lambda: phsplit.Vessel.preset("osw"), E, ("unknown vessel preset 'osw'", "'osv'")),
+    Bad("CLI: unknown vessel", cli(*SIM, "--vessel", "osw"), C, ("neither a file nor a shipped vessel", "osv")),
+]

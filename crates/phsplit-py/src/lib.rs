@@ -115,7 +115,9 @@ impl PyVessel {
     /// rows: the momenta are `(p, m) = M ν`.
     fn mass_matrix(&self) -> Vec<Vec<f64>> {
         let m = &self.inner.body.mass_matrix;
-        (0..6).map(|i| (0..6).map(|j| m[(i, j)]).collect()).collect()
+        (0..6)
+            .map(|i| (0..6).map(|j| m[(i, j)]).collect())
+            .collect()
     }
     /// The names of the vessel's components, in the order they are assembled.
     fn components(&self) -> Vec<&'static str> {

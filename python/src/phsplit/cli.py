@@ -14,6 +14,8 @@ EXAMPLES = """examples:
   phsplit simulate dp-weather              # a shipped scenario: station keeping in waves, wind, current, 1 h
   phsplit simulate --method sp2 --h 0.25 --t-end 400
   phsplit simulate --control-start never   # the controller off throughout
+  phsplit simulate --vessel osv --t-end 600  # Fossen's 83 m offshore supply vessel (MSS osv.m) in DP
+  phsplit vessels                          # the shipped vessels and their sources
   phsplit methods                          # methods with order, stages and passivity guarantee
   phsplit reproduce --out paper/           # the paper's Figs. 2-4, stability sweep and report
   phsplit reproduce --quick                # the same in a few seconds, with coarser references
@@ -54,6 +56,8 @@ def _parser() -> argparse.ArgumentParser:
     )
     s.add_argument("scenario", nargs="?", help="scenario TOML file, or the name of a shipped scenario "
                    "(pipelay, dp-weather; default: the paper's Fig. 2)")
+    s.add_argument("--vessel", help="run the scenario with this vessel: a vessel file, or a shipped "
+                   "vessel's name (see 'phsplit vessels')")
     s.add_argument("--out", default="out", help="output folder (default: ./out)")
     s.add_argument("--method", help="override the method")
     s.add_argument("--h", type=float, help="override the step size, s")
@@ -64,6 +68,7 @@ def _parser() -> argparse.ArgumentParser:
                    help="flow S2 exactly (matrix exponentials, the default) or by Gauss collocation (faster)")
     s.add_argument("--no-plot", action="store_true", help="skip the PNG")
     sub.add_parser("methods", help="list the integration methods")
+    sub.add_parser("vessels", help="list the shipped vessels (phsplit.Vessel.preset) and their sources")
     r = sub.add_parser(
         "reproduce",
         help="regenerate the paper's Figs. 2, 3, 4 and the stability sweep, with a report",
@@ -166,6 +171,8 @@ def _override_suffix(args) -> str:
         return s[:-2] if s.endswith(".0") else s
 
     parts = []
+    if getattr(args, "vessel", None):
+        parts.append(re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(args.vessel))[0]))
     if args.method:
         parts.append(args.method.lower())
     if args.h is not None:
@@ -247,6 +254,10 @@ def _simulate(args) -> int:
     sc = scn.load(args.scenario) if args.scenario else scn.Scenario.paper_fig2()
     if args.scenario:
         args.scenario = sc.path  # a shipped scenario's file
+    if args.vessel:
+        import dataclasses
+
+        sc = dataclasses.replace(sc, vessel=scn.vessel_named(args.vessel))
     over = {}
     if args.method:
         over["method"] = args.method
@@ -552,6 +563,15 @@ def _methods() -> int:
     return 0
 
 
+def _vessels() -> int:
+    import phsplit
+
+    for name, (desc, _) in phsplit.presets().items():
+        print(f"{name:8} {desc}")
+    print("use: phsplit simulate --vessel NAME, vessel = \"NAME\" in a scenario, or phsplit.Vessel.preset(NAME)")
+    return 0
+
+
 def _sigterm(signum, frame):
     raise KeyboardInterrupt
 
@@ -591,6 +611,8 @@ def main(argv: list[str] | None = None) -> int:
             return _plot(args)
         if args.command == "fmu":
             return _fmu(args)
+        if args.command == "vessels":
+            return _vessels()
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

@@ -2,7 +2,8 @@
 
 A scenario has a ``[simulation]`` table (every key optional; the defaults are the paper's
 Fig. 2 run, shared with :func:`phsplit.simulate`) and optionally a vessel: a path
-(``vessel = "my_vessel.toml"``, relative to the scenario file) or the paper's when absent.
+(``vessel = "my_vessel.toml"``, relative to the scenario file), a shipped vessel by name
+(``vessel = "osv"``; ``phsplit vessels``), or the paper's when absent.
 Any table of a vessel file given in the scenario (``[vessel]``, ``[control]``, ``[initial]``,
 ``[external]``, …) overrides that vessel key by key, so one gain or one load can be changed
 without copying the vessel file. Every key either acts or is refused: the core reads the
@@ -131,7 +132,7 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
     if v is None or isinstance(v, Mapping):
         base, source = Vessel.paper(), "paper"
     elif isinstance(v, str):
-        base, source = Vessel.from_toml(os.path.join(base_dir, v)), v
+        base, source = vessel_named(v, base_dir), v
     else:
         raise _core.ScenarioParseError(f"{path}: 'vessel' must be a file path or a table, got {v!r}")
     over = {k: val for k, val in data.items() if k in tables and not (k == "vessel" and isinstance(val, str))}
@@ -249,6 +250,20 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
             raise type(e)(f"{path}: {e}") from None
         out["wind"] = {**rest, **realised}
     return out
+
+
+def vessel_named(name: str, base_dir: str = ".") -> Vessel:
+    """A vessel file (a path, relative to ``base_dir``) or, where no such file exists, a shipped
+    vessel by name (``"osv"``; ``phsplit vessels`` lists them)."""
+    from .simulate import presets
+
+    p = os.path.join(base_dir, name)
+    if not os.path.exists(p) and os.sep not in name and not name.endswith(".toml"):
+        if name in presets():
+            return Vessel.preset(name)
+        known = ", ".join(presets())
+        raise _core.InvalidInputError(f"vessel {name!r} is neither a file nor a shipped vessel (shipped: {known})")
+    return Vessel.from_toml(p)
 
 
 def load(path: str | os.PathLike[str]) -> Scenario:

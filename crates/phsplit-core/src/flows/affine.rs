@@ -41,7 +41,11 @@ pub fn flow_and_gramian<const N: usize, const N2: usize>(
 where
     Const<N2>: DimMin<Const<N2>, Output = Const<N2>>,
 {
-    assert_eq!(N2, 2 * N, "the Van Loan exponential is twice the system's size");
+    assert_eq!(
+        N2,
+        2 * N,
+        "the Van Loan exponential is twice the system's size"
+    );
     let norm1 = (0..N)
         .map(|j| abar.column(j).iter().map(|v| v.abs()).sum::<f64>())
         .fold(0.0, f64::max)

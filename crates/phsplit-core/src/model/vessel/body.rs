@@ -63,11 +63,19 @@ impl Body {
     pub(crate) fn read(p: &mut Params) -> Result<Self> {
         const T: &str = "vessel";
         let mass = p.f64(T, "mass", "kg", Range::Positive)?;
-        let inertia: Vector3<f64> = p.vec3(T, "inertia", None, "kg m^2", Range::Positive)?.into();
+        let inertia: Vector3<f64> = p
+            .vec3(T, "inertia", None, "kg m^2", Range::Positive)?
+            .into();
         let rg: Vector3<f64> = p
             .vec3(T, "center_of_gravity", Some([0.0; 3]), "m", Range::Finite)?
             .into();
-        let added = match p.rows(T, "added_mass", 6, "kg, kg m and kg m^2 blocks", Range::Finite)? {
+        let added = match p.rows(
+            T,
+            "added_mass",
+            6,
+            "kg, kg m and kg m^2 blocks",
+            Range::Finite,
+        )? {
             None => M6::zeros(),
             Some(rows) => {
                 if rows.len() != 6 {
@@ -261,14 +269,23 @@ mod tests {
         assert!((b.free.inertia() - (t + Vector3::new(1e7, 2e8, 3e8))).norm() == 0.0);
         // Surge added mass only: not isotropic, Kirchhoff.
         let a = M6::from_diagonal(&V6::from_column_slice(&[1e6, 0.0, 0.0, 0.0, 0.0, 0.0]));
-        assert!(!Body::new(6.3e6, t, Vector3::zeros(), &a).unwrap().is_diagonal());
+        assert!(!Body::new(6.3e6, t, Vector3::zeros(), &a)
+            .unwrap()
+            .is_diagonal());
         // A negative added mass larger than the body's: not positive definite.
         let a = M6::from_diagonal(&V6::from_column_slice(&[0.0, -7e6, 0.0, 0.0, 0.0, 0.0]));
-        let e = Body::new(6.3e6, t, Vector3::zeros(), &a).unwrap_err().to_string();
-        assert!(e.contains("positive definite") && e.contains("smallest eigenvalue is -7"), "{e}");
+        let e = Body::new(6.3e6, t, Vector3::zeros(), &a)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("positive definite") && e.contains("smallest eigenvalue is -7"),
+            "{e}"
+        );
         let mut a = M6::zeros();
         a[(1, 5)] = 1e6;
-        let e = check_symmetric(&a, "vessel.added_mass").unwrap_err().to_string();
+        let e = check_symmetric(&a, "vessel.added_mass")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("entry [1][5] = 1000000 but [5][1] = 0"), "{e}");
     }
 }

@@ -17,9 +17,9 @@ pub mod params;
 pub mod state;
 pub mod system;
 
-pub use body::Body;
 use crate::error::Result;
 use crate::lie::so3;
+pub use body::Body;
 use forces::Force;
 use nalgebra::Vector3;
 use params::{Params, Range};

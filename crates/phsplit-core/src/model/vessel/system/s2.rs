@@ -246,7 +246,13 @@ impl VesselSystem<'_> {
     /// power at the stages (exact for the collocation polynomial's quadratic storage:
     /// `H(z1) − H(z0) = h Σ b_i Ḣ(Z_i)`). A singular stage system (impossible for a dissipative
     /// system, but checked) yields a non-finite state.
-    fn gauss_s2(&self, b: &S2Builder, z0: &[Z3; 2], h: f64, s: usize) -> ([Z3; 2], Work) {
+    pub(super) fn gauss_s2(
+        &self,
+        b: &S2Builder,
+        z0: &[Z3; 2],
+        h: f64,
+        s: usize,
+    ) -> ([Z3; 2], Work) {
         let nan = [[Vector3::from_element(f64::NAN); 3]; 2];
         let (Some((zt1, st)), Some((zr1, sr))) = (
             gauss::blocks_step(&b.sys[0], &z0[0], h, s),
@@ -266,7 +272,7 @@ impl VesselSystem<'_> {
 
     /// The exact flow of both block systems, balanced; with the ledger, each account's energy
     /// from one Gramian per system.
-    fn exact_s2(&self, b: &S2Builder, z0: &[Z3; 2], h: f64) -> ([Z3; 2], Work) {
+    pub(super) fn exact_s2(&self, b: &S2Builder, z0: &[Z3; 2], h: f64) -> ([Z3; 2], Work) {
         let minv = self.minv();
         let mut z1 = [[Vector3::zeros(); 3]; 2];
         let mut work = Work::default();
@@ -378,7 +384,8 @@ impl VesselSystem<'_> {
         }
         let mut r = SMatrix::<f64, 6, 19>::zeros();
         for (k, f) in rows.iter().enumerate() {
-            let mut rk = f.fnu[0] * e.fixed_view::<3, 19>(0, 0) + f.fnu[1] * e.fixed_view::<3, 19>(3, 0);
+            let mut rk =
+                f.fnu[0] * e.fixed_view::<3, 19>(0, 0) + f.fnu[1] * e.fixed_view::<3, 19>(3, 0);
             let mut fv = rk.fixed_view_mut::<3, 3>(0, 9 * k + 3);
             fv += f.fv;
             let mut fw = rk.fixed_view_mut::<3, 3>(0, 9 * k + 6);
@@ -398,7 +405,7 @@ impl VesselSystem<'_> {
     /// forcing iterated to a fixed point as in the block systems' collocation, with the same
     /// Aitken relaxation and stopping rule) and the ledger by the Gauss quadrature of the
     /// power, exact for the quadratic storage.
-    fn coupled_s2(
+    pub(super) fn coupled_s2(
         &self,
         fr: &Frozen,
         b: &S2Builder,
@@ -481,8 +488,13 @@ impl VesselSystem<'_> {
             let Some(y) = lu.solve(&rhs) else {
                 return nan;
             };
-            let r: [FullVector; 3] =
-                std::array::from_fn(|i| if i < s { y.fixed_rows::<19>(19 * i) - ys[i] } else { FullVector::zeros() });
+            let r: [FullVector; 3] = std::array::from_fn(|i| {
+                if i < s {
+                    y.fixed_rows::<19>(19 * i) - ys[i]
+                } else {
+                    FullVector::zeros()
+                }
+            });
             if let Some(pr) = &prev_r {
                 let (mut num, mut den) = (0.0, 0.0);
                 for i in 0..s {
@@ -498,7 +510,11 @@ impl VesselSystem<'_> {
             for i in 0..s {
                 let yi = ys[i] + r[i] * omega;
                 let res = r[i].amax() / yi.amax().max(f64::MIN_POSITIVE);
-                change = if res.is_nan() || change.is_nan() { f64::NAN } else { change.max(res) };
+                change = if res.is_nan() || change.is_nan() {
+                    f64::NAN
+                } else {
+                    change.max(res)
+                };
                 ys[i] = yi;
                 stage_z[i] = unpack_full(&yi.component_mul(&scale));
             }
@@ -507,7 +523,8 @@ impl VesselSystem<'_> {
                 return nan;
             }
             if !stateful
-                || (it > 0 && (change <= 4.0 * f64::EPSILON || (change >= last_change && change < 1e-12)))
+                || (it > 0
+                    && (change <= 4.0 * f64::EPSILON || (change >= last_change && change < 1e-12)))
             {
                 break;
             }

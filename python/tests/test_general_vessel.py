@@ -1,0 +1,202 @@
+"""Issue 18: the general vessel of eq. (1), a 6x6 mass matrix M = M_RB + M_A with the centre of
+gravity off the origin, and the offshore supply vessel of Fossen's MSS as a preset.
+
+References: the preset's numbers derived again here from the published inputs of osv.m
+(docs/research/mss_vessels.md §1); Fossen's equations in the body velocities written again in
+numpy (tests/fossen.py) and integrated by DOP853; the ledger; the paper's vessel."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+import fossen
+import phsplit
+from checks import within_passivity_bound
+
+OSV = phsplit.Vessel.preset("osv")
+
+
+def osv_published():
+    """The OSV's M, D, GM_T, GM_L and A_wp from osv.m's published inputs (Fossen's frame: z down,
+    y to starboard), by the formulas of osv.m, rbody.m, Gmtrx.m and Dmtrx.m."""
+    rho, g, L, B, T, cb, cw = 1025.0, 9.81, 83.0, 18.0, 5.0, 0.65, 0.8
+    vol = cb * L * B * T
+    m = rho * vol
+    rg = np.array([-4.5, 0.0, -1.2])
+    awp = cw * B * L
+    kb = (5 * T / 2 - vol / awp) / 3
+    k = 6 * cw ** 3 / ((1 + cw) * (1 + 2 * cw))
+    bg = (T - kb) - rg[2]
+    gmt = k * B ** 3 * L / 12 / vol - bg
+    gml = 0.7 * L ** 3 * B / 12 / vol - bg
+    ig = m * np.array([0.35 * B, 0.25 * L, 0.25 * L]) ** 2
+    # M_RB = H(r_g)^T blkdiag(m I, I_g) H(r_g), H(r) = [[I, S(r)^T], [0, I]] (Fossen 2021, eq. 3.27)
+    H = np.block([[np.eye(3), fossen.S(rg).T], [np.zeros((3, 3)), np.eye(3)]])
+    mrb = H.T @ np.block([[m * np.eye(3), np.zeros((3, 3))], [np.zeros((3, 3)), np.diag(ig)]]) @ H
+    ma = 1e9 * np.array([[0.0006, 0, 0, 0, 0, 0], [0, 0.0020, 0, 0.0031, 0, -0.0091],
+                         [0, 0, 0.0083, 0, 0.0907, 0], [0, 0.0031, 0, 0.0748, 0, -0.1127],
+                         [0, 0, 0.0907, 0, 3.9875, 0], [0, -0.0091, 0, -0.1127, 0, 1.2416]])
+    M = mrb + ma
+    g33, g44 = rho * g * awp, rho * g * vol * gmt
+    g55 = rho * g * vol * gml + 0.5 ** 2 * g33  # LCF = -0.5 m
+    w = np.sqrt(np.array([g33 / M[2, 2], g44 / M[3, 3], g55 / M[4, 4]]))
+    D = np.array([M[0, 0] / 100, M[1, 1] / 100, 2 * 0.2 * w[0] * M[2, 2], 2 * 0.15 * w[1] * M[3, 3],
+                  2 * 0.3 * w[2] * M[4, 4], M[5, 5] / 1])
+    return dict(m=m, M=M, D=D, gmt=gmt, gml=gml, awp=awp, ig=ig)
+
+
+FLIP = np.diag([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])  # Fossen's z down, y starboard -> z up, y port
+
+
+def test_the_osv_preset_is_osv_m_converted_to_z_up():
+    pub = osv_published()
+    d = OSV.to_dict()["vessel"]
+    want = FLIP @ pub["M"] @ FLIP
+    np.testing.assert_allclose(OSV.mass_matrix, want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
+    # the research notes' table of M (printed to 7 digits), converted: a check of the frame too
+    assert OSV.mass_matrix[1, 5] == pytest.approx(-3.149599e7, rel=1e-6)   # N_v-like, unchanged sign
+    assert OSV.mass_matrix[3, 5] == pytest.approx(1.395752e8, rel=1e-6)    # roll-yaw, sign flipped
+    assert OSV.mass_matrix[1, 3] == pytest.approx(-9.072265e6, rel=1e-6)   # sway-roll, sign flipped
+    assert OSV.mass_matrix[0, 4] == pytest.approx(5.972265e6, rel=1e-6)    # m z_g, z up
+    np.testing.assert_allclose(d["damping_translational"] + d["damping_rotational"], pub["D"], rtol=1e-12)
+    assert d["mass"] == pytest.approx(pub["m"], rel=1e-15)
+    assert d["gm_transverse"] == pytest.approx(pub["gmt"], rel=1e-14)
+    assert d["gm_longitudinal"] == pytest.approx(pub["gml"], rel=1e-14)
+    assert d["waterplane_area"] == pytest.approx(pub["awp"], rel=1e-15)
+    np.testing.assert_allclose(d["inertia"], pub["ig"], rtol=1e-14)
+    # the natural periods MSS prints (diagonal terms only; docs/research/mss_vessels.md §1.9)
+    M, g = pub["M"], 1025.0 * 9.81
+    t3 = 2 * np.pi / np.sqrt(g * pub["awp"] / M[2, 2])
+    assert round(t3, 2) == 6.60
+
+
+def y0_osv():
+    return dict(euler=[0.04, -0.015, 0.25], position=[12.0, -6.0, 0.3], velocity=[1.2, -0.6, 0.1],
+                angular_velocity=[0.01, -0.004, 0.015])
+
+
+@pytest.mark.parametrize("method,order,hs", [
+    ("sp2", 2, [1.0, 0.5, 0.25, 0.125]),
+    ("sp4", 4, [2.0, 1.0, 0.5, 0.25]),
+    ("sp6", 6, [1.0, 0.75, 0.5]),
+])
+def test_orders_and_agreement_against_fossens_equations(method, order, hs):
+    """SP2/SP4/SP6 on the OSV (full added mass, CG off the origin, cross-flow drag), controller on,
+    against Fossen's M nu' + C(nu) nu + D nu + g = tau in numpy by DOP853: fitted orders, and the
+    finest step's agreement."""
+    init = y0_osv()
+    t_end = 16.0
+    ref = fossen.solve(OSV.to_dict(), fossen.initial(**init), t_end, rtol=1e-13)
+    nu_ref, q_ref, x_ref = ref[0:6], ref[6:15].reshape(3, 3, order="F"), ref[15:18]
+    y0 = OSV.initial_state(**init)
+    errs = []
+    for h in hs:
+        s = phsplit.simulate(OSV, (0.0, t_end), h, method, control_start=0.0, initial=y0, ledger=False)
+        assert s.status == "completed"
+        nu = np.concatenate([s.v[-1], s.w[-1]])
+        e = max(np.linalg.norm(nu - nu_ref) / np.linalg.norm(nu_ref),
+                np.linalg.norm(s.Q[-1] - q_ref) / np.sqrt(3),
+                np.linalg.norm(s.x[-1] - x_ref) / np.linalg.norm(x_ref))
+        errs.append(e)
+    errs = np.array(errs)
+    slope = np.polyfit(np.log(hs), np.log(errs), 1)[0]
+    assert abs(slope - order) < 0.2, (slope, errs)
+    assert errs[-1] < {2: 1e-4, 4: 1e-6, 6: 1e-8}[order], errs
+
+
+@pytest.mark.parametrize("method,h", [("sp2", 1 / 512), ("sp4", 1 / 16), ("sp6", 0.5)])
+def test_fine_steps_agree_to_1e_8(method, h):
+    """At a fine step each method agrees with the independent model to 1e-8 relative."""
+    init = y0_osv()
+    ref = fossen.solve(OSV.to_dict(), fossen.initial(**init), 16.0, rtol=1e-13)
+    s = phsplit.simulate(OSV, (0.0, 16.0), h, method, control_start=0.0, initial=OSV.initial_state(**init),
+                         ledger=False)
+    nu = np.concatenate([s.v[-1], s.w[-1]])
+    assert np.linalg.norm(nu - ref[0:6]) / np.linalg.norm(ref[0:6]) < 1e-8
+    assert np.linalg.norm(s.x[-1] - ref[15:18]) / np.linalg.norm(ref[15:18]) < 1e-8
+    assert np.linalg.norm(s.Q[-1] - ref[6:15].reshape(3, 3, order="F")) < 1e-8
+
+
+def with_quadratic():
+    t = OSV.to_dict()
+    t["damping_quadratic"] = {"coefficients": [1.81312e4, 2.0e5, 4.0e5, 3.0e7, 2.0e10, 8.0e9]}
+    t["current"] = {"velocity": [0.4, -0.3, 0.0]}
+    return phsplit.Vessel.from_dict(t)
+
+
+@pytest.mark.parametrize("method,lf", [("sp2", "exact"), ("sp4", "gauss"), ("sp6", "exact")])
+def test_the_ledger_closes_with_a_general_mass_matrix(method, lf):
+    for v in (OSV, with_quadratic()):
+        s = phsplit.simulate(v, (0.0, 300.0), 0.5, method, control_start=10.0, linear_flow=lf)
+        assert s.status == "completed"
+        assert np.all(s.ledger.relative_residual() < 1e-10), s.ledger.relative_residual().max()
+        for name, kind in v.accounts:
+            if kind == "dissipated":
+                assert s.ledger.by_account[name][1:].min() >= 0, name
+
+
+@pytest.mark.parametrize("h", [1.0, 5.0, 10.0, 20.0])
+def test_sp2_stays_within_its_passivity_bound_up_to_20_s(h):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", phsplit.StepSizeWarning)
+        s = phsplit.simulate(OSV, (0.0, 3600.0), h, "sp2", control_start=0.0)
+    assert s.status == "completed" and within_passivity_bound(s)
+    # the DP holds: at the set point after an hour
+    assert np.linalg.norm(s.x[-1, :2] - [20.0, 10.0]) < 0.5, s.x[-1]
+
+
+@pytest.mark.parametrize("method", ["lie", "sp2", "sp4", "sp6", "rk4"])
+def test_the_paper_vessel_written_as_a_general_vessel_is_the_paper_vessel(method):
+    t = phsplit.Vessel.paper().to_dict()
+    t["vessel"]["added_mass"] = np.zeros((6, 6)).tolist()
+    t["vessel"]["center_of_gravity"] = [0.0, 0.0, 0.0]
+    b = phsplit.simulate(phsplit.Vessel.from_dict(t), method=method)
+    a = phsplit.simulate(phsplit.Vessel.paper(), method=method)
+    for k in ("x", "euler", "p", "m", "energy"):
+        ref = getattr(a, k)
+        assert np.abs(getattr(b, k) - ref).max() <= 1e-12 * np.abs(ref).max(), k
+
+
+def test_bad_mass_matrices_are_named():
+    t = OSV.to_dict()
+    t["vessel"]["added_mass"][1][5] = -8.0e6
+    with pytest.raises(phsplit.InvalidInputError, match=r"vessel.added_mass must be symmetric: entry \[1\]\[5\]"):
+        phsplit.Vessel.from_dict(t)
+    t = OSV.to_dict()
+    t["vessel"]["added_mass"][1][1] = -6.0e6  # more negative than the body's mass
+    with pytest.raises(phsplit.InvalidInputError, match="mass matrix M = M_RB \\+ M_A .* positive definite; its smallest eigenvalue is -"):
+        phsplit.Vessel.from_dict(t)
+    t = OSV.to_dict()
+    t["vessel"]["added_mass"] = t["vessel"]["added_mass"][:5]
+    with pytest.raises(phsplit.InvalidInputError, match="6 rows of 6"):
+        phsplit.Vessel.from_dict(t)
+    with pytest.raises(phsplit.InvalidInputError, match="unknown vessel preset 'osw'.*'osv'"):
+        phsplit.Vessel.preset("osw")
+
+
+def test_the_presets_on_the_command_line_and_in_scenarios(tmp_path, capsys):
+    from phsplit import cli
+
+    assert cli.main(["vessels"]) == 0
+    out = capsys.readouterr().out
+    assert "osv" in out and "osv.m" in out and "paper" in out
+    sc = tmp_path / "dp.toml"
+    sc.write_text('vessel = "osv"\n[simulation]\nt_span = [0.0, 20.0]\nh = 0.5\n[control]\nposition_reference = [5.0, 0.0, 0.0]\n')
+    s = phsplit.load_scenario(str(sc))
+    np.testing.assert_array_equal(s.vessel.mass_matrix, OSV.mass_matrix)
+    assert s.vessel.to_dict()["control"]["position_reference"] == [5.0, 0.0, 0.0]
+    assert cli.main(["simulate", str(sc), "--vessel", "paper", "--out", str(tmp_path), "--no-plot"]) == 0
+    assert (tmp_path / "dp-paper.nc").exists()
+    assert cli.main(["simulate", "--vessel", "osv", "--t-end", "10", "--out", str(tmp_path), "--no-plot"]) == 0
+    import xarray as xr
+
+    with xr.open_dataset(tmp_path / "fig2-osv-t10.nc") as ds:
+        # the body velocities are M^-1 (p, m) with the general M
+        u = np.hstack([ds["linear_momentum"].values, ds["angular_momentum"].values])
+        nu = np.linalg.solve(OSV.mass_matrix, u.T).T
+        np.testing.assert_allclose(ds["velocity"].values, nu[:, :3], rtol=1e-10, atol=1e-14)
+        np.testing.assert_allclose(ds["angular_velocity"].values, nu[:, 3:], rtol=1e-10, atol=1e-16)
+    assert cli.main(["simulate", "--vessel", "osw", "--out", str(tmp_path)]) == 2
+    assert "neither a file nor a shipped vessel (shipped: paper, osv)" in capsys.readouterr().err
