@@ -316,9 +316,6 @@ impl VesselSystem<'_> {
 /// The state of the coupled system: `z̄ = (u_t, v_t, w_t, u_r, v_r, w_r, 1)`.
 type Full = SMatrix<f64, 19, 19>;
 type FullVector = SVector<f64, 19>;
-/// The stage system of at most three Gauss stages of the coupled system.
-type FullStages = SMatrix<f64, 57, 57>;
-type FullStageVector = SVector<f64, 57>;
 
 /// Flow S2 as one augmented matrix `Ā` on `z̄ = (u_t, v_t, w_t, u_r, v_r, w_r, 1)`: the two
 /// block systems on the diagonal and, when they are coupled, what each takes from the other's
@@ -414,7 +411,6 @@ impl VesselSystem<'_> {
         t: f64,
         s: usize,
     ) -> ([Z3; 2], Work) {
-        let nan = ([[Vector3::from_element(f64::NAN); 3]; 2], Work::default());
         let scale = self.balance_full(b);
         let inv = scale.map(|v| 1.0 / v);
         let abar = augmented(b);
@@ -437,13 +433,40 @@ impl VesselSystem<'_> {
             let z1 = unpack_full(&zb1.component_mul(&scale));
             return (z1, work);
         }
+        match s {
+            1 => self.coupled_collocation::<19>(fr, b, z0, &a, &scale, h, t, 1),
+            2 => self.coupled_collocation::<38>(fr, b, z0, &a, &scale, h, t, 2),
+            _ => self.coupled_collocation::<57>(fr, b, z0, &a, &scale, h, t, 3),
+        }
+    }
+
+    /// The Gauss collocation of [`Self::coupled_s2`] with `s` stages, `NS = 19 s`, on the
+    /// balanced system `a` (scaling `scale`).
+    #[allow(clippy::too_many_arguments)]
+    fn coupled_collocation<const NS: usize>(
+        &self,
+        fr: &Frozen,
+        b: &S2Builder,
+        z0: &[Z3; 2],
+        a: &Full,
+        scale: &FullVector,
+        h: f64,
+        t: f64,
+        s: usize,
+    ) -> ([Z3; 2], Work)
+    where
+        nalgebra::Const<NS>: nalgebra::DimMin<nalgebra::Const<NS>, Output = nalgebra::Const<NS>>,
+    {
+        let nan = ([[Vector3::from_element(f64::NAN); 3]; 2], Work::default());
+        let inv = scale.map(|v| 1.0 / v);
+        let zb0 = pack_full(z0, 1.0).component_mul(&inv);
         let (ta, bw) = gauss::tableau(s);
         let nodes: [f64; 3] = std::array::from_fn(|i| ta[i].iter().sum());
-        let mut m = FullStages::identity();
+        let mut m = SMatrix::<f64, NS, NS>::identity();
         for i in 0..s {
             for j in 0..s {
                 let mut v = m.fixed_view_mut::<19, 19>(19 * i, 19 * j);
-                v -= a * (h * ta[i][j]);
+                v -= *a * (h * ta[i][j]);
             }
         }
         let lu = m.lu();
@@ -477,7 +500,7 @@ impl VesselSystem<'_> {
             }
             let gt: [FullVector; 3] =
                 std::array::from_fn(|j| pack_full(&g[j].g, 0.0).component_mul(&inv));
-            let mut rhs = FullStageVector::zeros();
+            let mut rhs = SVector::<f64, NS>::zeros();
             for i in 0..s {
                 let mut r = zb0;
                 for j in 0..s {
@@ -516,7 +539,7 @@ impl VesselSystem<'_> {
                     change.max(res)
                 };
                 ys[i] = yi;
-                stage_z[i] = unpack_full(&yi.component_mul(&scale));
+                stage_z[i] = unpack_full(&yi.component_mul(scale));
             }
             prev_r = Some(r);
             if !change.is_finite() {
@@ -538,9 +561,9 @@ impl VesselSystem<'_> {
         }
         let mut y1 = zb0;
         for i in 0..s {
-            y1 += (a * ys[i] + pack_full(&g[i].g, 0.0).component_mul(&inv)) * (h * bw[i]);
+            y1 += (*a * ys[i] + pack_full(&g[i].g, 0.0).component_mul(&inv)) * (h * bw[i]);
         }
-        let z1 = unpack_full(&y1.component_mul(&scale));
+        let z1 = unpack_full(&y1.component_mul(scale));
         let mut work = Work::default();
         if let Some(booked) = &b.booked {
             for i in 0..s {
