@@ -55,6 +55,7 @@ bench: $(VENV)/.built $(VENV)/.bench-deps
 	$(BIN)/python benchmarks/work_precision.py
 	$(BIN)/python benchmarks/sweep_throughput.py
 	$(BIN)/python benchmarks/weather_stability.py
+	$(BIN)/python benchmarks/general_vessel.py
 	$(BIN)/python benchmarks/fmu_speed.py
 
 bench-quick: $(VENV)/.built $(VENV)/.bench-deps

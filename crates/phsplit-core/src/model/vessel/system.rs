@@ -440,9 +440,9 @@ impl<'a> VesselSystem<'a> {
     /// Flow S1 over `h` (paper §3.4.1; docs/model.md §3.8); `mu, x, phi` unchanged. For `M` of
     /// the paper's form, exact: the free rigid body with a Magnus attitude of the given order,
     /// `p(h) = Q(h)ᵀ Q0 p0`. For a general `M`, Kirchhoff's equations by Gauss collocation of the
-    /// same order (H kept to round-off) with the attitude by Runge–Kutta–Munthe-Kaas; where
-    /// that does not converge (a step far too long for the rotation) the state becomes NaN and
-    /// the run stops with what it had.
+    /// same order (H kept to round-off) with the attitude by Runge–Kutta–Munthe-Kaas; a step too
+    /// long for its Newton iteration (`h|ω| ≳ 1`) is taken in 2, 4, … up to 1024 equal sub-steps;
+    /// beyond that the state becomes NaN and the run stops with what it had.
     pub fn flow_s1(&self, s: &mut VesselState, h: f64, order: MagnusOrder) {
         if let Some(k) = &self.vessel.body.kirchhoff {
             let stages = match order {
@@ -451,18 +451,37 @@ impl<'a> VesselSystem<'a> {
                 MagnusOrder::Six => 3,
             };
             let mut u = nalgebra::SVector::<f64, 6>::zeros();
+            const MAX_S1_HALVINGS: usize = 10;
             u.fixed_rows_mut::<3>(0).copy_from(&s.p);
             u.fixed_rows_mut::<3>(3).copy_from(&s.m);
-            match k.flow(&u, &s.q, h, stages) {
-                Some((u1, q1)) => {
-                    s.p = u1.fixed_rows::<3>(0).into_owned();
-                    s.m = u1.fixed_rows::<3>(3).into_owned();
-                    s.q = q1;
+            // Newton's method on the stages converges for h|ω| up to about 1; a longer step is
+            // taken as 2, 4, … equal sub-steps (each keeps H, so the flow still does).
+            let mut q = s.q;
+            let mut done = false;
+            for k2 in 0..=MAX_S1_HALVINGS {
+                let n = 1usize << k2;
+                let dt = h / n as f64;
+                let (mut uu, mut qq) = (u, q);
+                let ok = (0..n).all(|_| match k.flow(&uu, &qq, dt, stages) {
+                    Some((u1, q1)) => {
+                        (uu, qq) = (u1, q1);
+                        true
+                    }
+                    None => false,
+                });
+                if ok {
+                    (u, q) = (uu, qq);
+                    done = true;
+                    break;
                 }
-                None => {
-                    s.p = Vector3::from_element(f64::NAN);
-                    s.m = s.p;
-                }
+            }
+            if done {
+                s.p = u.fixed_rows::<3>(0).into_owned();
+                s.m = u.fixed_rows::<3>(3).into_owned();
+                s.q = q;
+            } else {
+                s.p = Vector3::from_element(f64::NAN);
+                s.m = s.p;
             }
             return;
         }
