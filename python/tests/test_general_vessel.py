@@ -200,3 +200,16 @@ def test_the_presets_on_the_command_line_and_in_scenarios(tmp_path, capsys):
         np.testing.assert_allclose(ds["angular_velocity"].values, nu[:, 3:], rtol=1e-10, atol=1e-16)
     assert cli.main(["simulate", "--vessel", "osw", "--out", str(tmp_path)]) == 2
     assert "neither a file nor a shipped vessel (shipped: paper, osv)" in capsys.readouterr().err
+
+
+def test_a_vessel_file_with_full_matrices_in_a_scenario(tmp_path):
+    """A user's vessel file with the full matrices (the OSV's, written out by to_toml) named by
+    path in a scenario rebuilds the same vessel."""
+    (tmp_path / "my_osv.toml").write_text(OSV.to_toml())
+    sc = tmp_path / "run.toml"
+    sc.write_text('vessel = "my_osv.toml"\n[simulation]\nt_span = [0.0, 10.0]\nh = 0.5\nmethod = "sp2"\n')
+    s = phsplit.load_scenario(str(sc))
+    np.testing.assert_array_equal(s.vessel.mass_matrix, OSV.mass_matrix)
+    a = phsplit.simulate(s.vessel, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
+    b = phsplit.simulate(OSV, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
+    np.testing.assert_array_equal(a.x, b.x)

@@ -37,8 +37,6 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 type V6 = SVector<f64, 6>;
 type M6 = SMatrix<f64, 6, 6>;
-/// The stage system of at most three stages.
-type Stages = SMatrix<f64, 18, 18>;
 
 /// Most Newton iterations (and fixed-point passes of the attitude) per step. Newton's method
 /// converges for `h|ω|` up to about 1; longer steps give `None`.
@@ -126,16 +124,19 @@ impl Kirchhoff {
         direct + through * self.minv
     }
 
-    /// One step of length `h` with `s` Gauss stages (1 to 3; order `2s`): the momenta `u` and
-    /// the attitude `q`. `None` if Newton's method does not converge (a step far too long).
-    pub fn flow(&self, u0: &V6, q0: &Matrix3<f64>, h: f64, s: usize) -> Option<(V6, Matrix3<f64>)> {
-        if !(1..=3).contains(&s) || !u0.iter().all(|x| x.is_finite()) || !h.is_finite() {
-            return None;
-        }
-        let (a, b) = tableau(s);
-        // Stages Y_i, from u0.
+    /// The stages `Y_i = u0 + h Σ_j a_ij f(Y_j)` by Newton's method with the exact Jacobian
+    /// (`NS = 6s`), or `None` if it does not converge.
+    fn stages<const NS: usize>(
+        &self,
+        u0: &V6,
+        h: f64,
+        s: usize,
+        a: &[[f64; 3]; 3],
+    ) -> Option<[V6; 3]>
+    where
+        nalgebra::Const<NS>: nalgebra::DimMin<nalgebra::Const<NS>, Output = nalgebra::Const<NS>>,
+    {
         let mut y = [*u0; 3];
-        let mut converged = false;
         for _ in 0..MAX_NEWTON {
             let f: [V6; 3] = std::array::from_fn(|i| {
                 if i < s {
@@ -144,8 +145,8 @@ impl Kirchhoff {
                     V6::zeros()
                 }
             });
-            let mut res = SVector::<f64, 18>::zeros();
-            let mut jac = Stages::identity();
+            let mut res = SVector::<f64, NS>::zeros();
+            let mut jac = SMatrix::<f64, NS, NS>::identity();
             for i in 0..s {
                 let mut r = y[i] - u0;
                 for j in 0..s {
@@ -174,13 +175,25 @@ impl Kirchhoff {
                 return None;
             }
             if step <= 2.0 * f64::EPSILON * size.max(f64::MIN_POSITIVE) {
-                converged = true;
-                break;
+                return Some(y);
             }
         }
-        if !converged {
+        None
+    }
+
+    /// One step of length `h` with `s` Gauss stages (1 to 3; order `2s`): the momenta `u` and
+    /// the attitude `q`. `None` if Newton's method does not converge (a step far too long).
+    pub fn flow(&self, u0: &V6, q0: &Matrix3<f64>, h: f64, s: usize) -> Option<(V6, Matrix3<f64>)> {
+        if !(1..=3).contains(&s) || !u0.iter().all(|x| x.is_finite()) || !h.is_finite() {
             return None;
         }
+        let (a, b) = tableau(s);
+        // Stages Y_i, from u0, by Newton's method on a stage system sized to the stages.
+        let y = match s {
+            1 => self.stages::<6>(u0, h, 1, &a)?,
+            2 => self.stages::<12>(u0, h, 2, &a)?,
+            _ => self.stages::<18>(u0, h, 3, &a)?,
+        };
         let f: [V6; 3] = std::array::from_fn(|i| {
             if i < s {
                 self.field(&y[i])
