@@ -375,3 +375,8 @@ CATALOGUE += [
     Bad("unknown vessel preset", lambda: phsplit.Vessel.preset("osw"), E, ("unknown vessel preset 'osw'", "'osv'")),
     Bad("CLI: unknown vessel", cli(*SIM, "--vessel", "osw"), C, ("neither a file nor a shipped vessel", "osv")),
 ]
+
+CATALOGUE += [
+    Bad("centre of flotation far off the hull", vessel_with("gravity = 9.81", "gravity = 9.81\nflotation_center_x = 5000.0"),
+        E, ("vessel.flotation_center_x", "±1000 m")),
+]

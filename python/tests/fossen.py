@@ -9,8 +9,9 @@ r_g, inertia I_g about it), C(nu) from M in the velocity-independent parametrisa
 symmetric M (Fossen 2021, eq. 6.43 for M_A; the same form for M_RB, Theorem 3.2),
 C(nu) = [[0, -S(M11 nu1 + M12 nu2)], [-S(M11 nu1 + M12 nu2), -S(M21 nu1 + M22 nu2)]]; cross-flow
 drag by strip theory (eq. 6.99-6.100, by Gauss-Legendre quadrature exact on each piece); restoring in the paper's form
-(docs/model.md §2: heave -rho g A_wp z, moment -(G q3) x q3 with G = m g (GM_L, GM_T, 0) and
-q3 = Q^T e3); the PID of the paper's eqs. 29-33. Integrated by scipy's DOP853 at tight tolerance.
+with the heave spring at the centre of flotation x_F (docs/model.md §2, §5.15: the potential
+V = c/2 (z + x_F q3_x)^2 + q3^T G q3 / 2, c = rho g A_wp, G = m g (GM_L, GM_T, 0), q3 = Q^T e3;
+heave force -dV/dz along q3, moment q3 x dV/dq3); the PID of the paper's eqs. 29-33. Integrated by scipy's DOP853 at tight tolerance.
 
 Nothing here calls phsplit's integrators or vector field, and the state is not phsplit's (nu, not
 the momenta; no restoring variable mu): only the vessel file's numbers and the initial state are
@@ -64,6 +65,7 @@ class Vessel:
         self.heave = h["gravity"] * h["water_density"] * h["waterplane_area"]
         w = m * h["gravity"]
         self.G = np.array([w * h["gm_longitudinal"], w * h["gm_transverse"], 0.0])
+        self.xf = h.get("flotation_center_x", 0.0)  # the heave spring acts at the centre of flotation
         c = params["control"]
         k = 1.0 if control_on else 0.0
         self.K = {n: k * np.diag(c[n]) for n in ("kp_translational", "kd_translational", "ki_translational",
@@ -113,7 +115,10 @@ class Vessel:
             -Q.T @ (K["kp_translational"] @ (x - self.xr) + K["kd_translational"] @ (Q @ v) + K["ki_translational"] @ phx),
             -W.T @ (K["kp_rotational"] @ (th - self.thr) + K["kd_rotational"] @ (W @ w) + K["ki_rotational"] @ phth),
         ])
-        g = np.concatenate([Q.T @ np.array([0.0, 0.0, self.heave * x[2]]), np.cross(self.G * q3, q3)])
+        # V = c/2 (z + x_F q3_x)^2 + q3^T G q3 / 2: z_F is the height of the centre of flotation
+        zf = x[2] + self.xf * q3[0]
+        dv_dq3 = self.G * q3 + np.array([self.heave * zf * self.xf, 0.0, 0.0])
+        g = np.concatenate([q3 * self.heave * zf, np.cross(dv_dq3, q3)])
         rhs = tau - self.coriolis(nu) @ nu - self.D @ nu - self.cq * np.abs(nu) * nu + self.crossflow(nu) - g
         dy = np.empty(24)
         dy[0:6] = np.linalg.solve(self.M, rhs)

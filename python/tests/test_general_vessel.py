@@ -72,6 +72,35 @@ def test_the_osv_preset_is_osv_m_converted_to_z_up():
     assert round(t3, 2) == 6.60
 
 
+def test_the_natural_periods_are_those_of_fossens_linear_model():
+    """Without damping, phsplit's linearised flow S2 at rest (the OSV: full M, the heave spring at
+    the centre of flotation) has the natural periods of Fossen's linear model M nu' + G eta = 0,
+    2 pi / sqrt(eig(M^-1 G)), with osv.m's M and G (Gmtrx.m: G33, G35 = -LCF G33, G44,
+    G55 = rho g V GM_L + LCF^2 G33) converted to z up."""
+    pub = osv_published()
+    t = OSV.to_dict()
+    t["vessel"]["damping_translational"] = [0.0] * 3
+    t["vessel"]["damping_rotational"] = [0.0] * 3
+    del t["crossflow_drag"]
+    undamped = phsplit.Vessel.from_dict(t)
+    got = undamped.natural_periods(control=False, euler=[0.0, 0.0, 0.0])
+    rho_g = 1025.0 * 9.81
+    vol = pub["m"] / 1025.0
+    G = np.zeros((6, 6))
+    G[2, 2] = rho_g * pub["awp"]
+    G[2, 4] = G[4, 2] = 0.5 * G[2, 2]  # -LCF G33 with LCF = -0.5 m (Fossen's frame)
+    G[3, 3] = rho_g * vol * pub["gmt"]
+    G[4, 4] = rho_g * vol * pub["gml"] + 0.25 * G[2, 2]
+    lam = np.linalg.eigvals(np.linalg.solve(pub["M"], G))
+    want = sorted(2 * np.pi / np.sqrt(lam.real[lam.real > 1e-9]))
+    assert len(got) == 3 and len(want) == 3
+    np.testing.assert_allclose(got, want, rtol=1e-9)
+    # without the centre of flotation (x_F = 0) they differ: the coupling is seen
+    t["vessel"]["flotation_center_x"] = 0.0
+    other = phsplit.Vessel.from_dict(t).natural_periods(control=False, euler=[0.0, 0.0, 0.0])
+    assert np.max(np.abs(np.array(other) - want) / np.array(want)) > 1e-4
+
+
 def y0_osv():
     return dict(euler=[0.04, -0.015, 0.25], position=[12.0, -6.0, 0.3], velocity=[1.2, -0.6, 0.1],
                 angular_velocity=[0.01, -0.004, 0.015])

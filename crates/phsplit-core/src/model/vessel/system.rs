@@ -252,7 +252,9 @@ impl<'a> VesselSystem<'a> {
             for l in ev.iter() {
                 let (re, im) = (l.re * scale, l.im * scale);
                 let r = re.hypot(im);
-                if im > 1e-9 * r && r > 0.0 {
+                // A zero mode (surge, sway, yaw without damping) comes out as round-off with a
+                // round-off imaginary part: not an oscillation.
+                if im > 1e-9 * r && r > 1e-12 * scale {
                     out.push(2.0 * std::f64::consts::PI / r);
                 }
             }
@@ -326,9 +328,9 @@ impl<'a> VesselSystem<'a> {
                 let [mut ft, mut fr] = [b.sys[0].field(&zs[0]), b.sys[1].field(&zs[1])];
                 if let Some(c) = &b.cross {
                     // What each system takes from the other's momentum.
-                    ft[0] += c[0][0] * zs[1][0];
+                    ft[0] += c[0][0] * zs[1][0] + c[0][2] * zs[1][1];
                     ft[1] += c[0][1] * zs[1][0];
-                    fr[0] += c[1][0] * zs[0][0];
+                    fr[0] += c[1][0] * zs[0][0] + c[1][2] * zs[0][1];
                     fr[1] += c[1][1] * zs[0][0];
                 }
                 if self.forced {
@@ -971,7 +973,7 @@ mod tests {
                     LinearFlow::Exact => sys.exact_s2(&b, &z0, h),
                     LinearFlow::Gauss => sys.gauss_s2(&b, &z0, h, stages),
                 };
-                b.cross = Some([[Matrix3::zeros(); 2]; 2]);
+                b.cross = Some([[Matrix3::zeros(); 3]; 2]);
                 let (zb, wb) = sys.coupled_s2(&fr, &b, &z0, h, 0.0, stages);
                 for k in 0..2 {
                     for i in 0..3 {
@@ -1064,6 +1066,63 @@ mod tests {
         }
         assert!(worst <= 1e-13, "H drifts by {worst:e}");
         assert!(so3::orthogonality_defect(&s.q) < 1e-12);
+    }
+
+    /// The restoring with the heave spring at the centre of flotation (the OSV's `x_F = −0.5 m`):
+    /// the initial state is on the invariant `mu = G q3 − k z e1`, the projection brings a state
+    /// that left it back (the attitude turned, `mu` and `z` kept) and leaves `H` as it was.
+    #[test]
+    fn the_flotation_centre_keeps_its_invariant_and_projection() {
+        let v = Vessel::preset("osv").unwrap();
+        let r = v.force("restoring").unwrap();
+        let sys = VesselSystem::new(&v, Some(0.0));
+        let mut s = v.state_from(
+            Vector3::new(0.04, -0.03, 0.2),
+            Vector3::new(3.0, -2.0, 0.4),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        );
+        // mu from its definition, written out: G' = mv g diag(GM_L, GM_T, 0) + diag(x_F² c, 0, 0),
+        // k = −x_F c.
+        let (m, gr) = (scalar(&v, "mass"), scalar(&v, "gravity"));
+        let c = gr * scalar(&v, "water_density") * scalar(&v, "waterplane_area");
+        let xf = scalar(&v, "flotation_center_x");
+        let g1 = m * gr * scalar(&v, "gm_longitudinal") + xf * xf * c;
+        let g2 = m * gr * scalar(&v, "gm_transverse");
+        let want = |s: &VesselState| {
+            let q3 = s.q.transpose() * Vector3::z();
+            Vector3::new(g1 * q3.x + xf * c * s.x.z, g2 * q3.y, 0.0)
+        };
+        assert!((s.mu - want(&s)).norm() <= 1e-12 * s.mu.norm());
+        // Flow S1 turns Q without mu: off the invariant; the projection restores it.
+        sys.flow_s1(&mut s, 2.0, MagnusOrder::Four);
+        s.m += Vector3::new(1e7, -2e7, 3e7);
+        sys.flow_s1(&mut s, 3.0, MagnusOrder::Four);
+        let off = (s.mu - want(&s)).norm() / s.mu.norm();
+        assert!(off > 1e-6, "{off}");
+        let h0 = v.energy(&s);
+        r.project(&mut s);
+        assert!(
+            (s.mu - want(&s)).norm() <= 1e-12 * s.mu.norm(),
+            "{}",
+            (s.mu - want(&s)).norm()
+        );
+        assert_eq!(v.energy(&s), h0);
+        // The store at rest tilted: V = ½ c z_F² + ½ q3ᵀ G q3 on the invariant (with the paper's
+        // G = mv g diag(GM_L, GM_T, 0) and z_F = z + x_F q3_x).
+        let q3 = s.q.transpose() * Vector3::z();
+        let zf = s.x.z + xf * q3.x;
+        let v_pot = 0.5 * c * zf * zf
+            + 0.5
+                * m
+                * gr
+                * (scalar(&v, "gm_longitudinal") * q3.x * q3.x
+                    + scalar(&v, "gm_transverse") * q3.y * q3.y);
+        assert!(
+            (r.storage(&s) - v_pot).abs() <= 1e-12 * v_pot,
+            "{} vs {v_pot}",
+            r.storage(&s)
+        );
     }
 
     /// A partial rebuild (the FMU's inputs) gives the vessel a whole rebuild of the same file

@@ -173,9 +173,12 @@ pub struct S2Builder {
     nu_u: [[Matrix3<f64>; 2]; 2],
     /// Rate of `v_k` per velocity `ν_j`, before [`Self::finish`].
     nu_v: [[Matrix3<f64>; 2]; 2],
+    /// Force on `u_k` per the other system's second state `v_l` (the restoring's heave–pitch
+    /// coupling through `mu`).
+    other_v: [Matrix3<f64>; 2],
     /// After [`Self::finish`], when the systems are coupled: for each system `k`, the rows of
-    /// `u_k'` and of `v_k'` on the other system's momentum.
-    pub cross: Option<[[Matrix3<f64>; 2]; 2]>,
+    /// `u_k'` and of `v_k'` on the other system's momentum, and of `u_k'` on its `v`.
+    pub cross: Option<[[Matrix3<f64>; 3]; 2]>,
     /// Force rows per account and system (only with `ledger`).
     pub booked: Option<Box<[[Rows; 2]; MAX_ACCOUNTS]>>,
     /// First account of the component being assembled.
@@ -197,6 +200,7 @@ impl S2Builder {
             sys: [zero; 2],
             nu_u: [[Matrix3::zeros(); 2]; 2],
             nu_v: [[Matrix3::zeros(); 2]; 2],
+            other_v: [Matrix3::zeros(); 2],
             cross: None,
             booked: ledger.then(|| Box::new([[Rows::ZERO; 2]; MAX_ACCOUNTS])),
             base: 0,
@@ -222,6 +226,12 @@ impl S2Builder {
     pub fn rate_v(&mut self, sys: Sys, of: Sys, r: &Matrix3<f64>) {
         self.nu_v[sys as usize][of as usize] += r;
     }
+    /// Add a force `r v_l` on the momentum of `sys` from the second state `v_l` of the other
+    /// system, booked to no account (a conservative exchange between stores of H: the
+    /// restoring's heave–pitch coupling).
+    pub fn force_from_other_v(&mut self, sys: Sys, r: &Matrix3<f64>) {
+        self.other_v[sys as usize] += r;
+    }
     /// The block system `sys`, to add the rows of the integral states a component drives
     /// (`w' = A_wv v + c_w`).
     pub fn rows(&mut self, sys: Sys) -> &mut Blocks {
@@ -231,15 +241,20 @@ impl S2Builder {
     /// `minv[j][l]` of `M⁻¹`; decide whether the systems are coupled.
     pub(crate) fn finish(&mut self, minv: &[[Matrix3<f64>; 2]; 2], diagonal: bool) {
         let on_u = |r: &[Matrix3<f64>; 2], l: usize| r[0] * minv[0][l] + r[1] * minv[1][l];
-        let mut cross = [[Matrix3::zeros(); 2]; 2];
+        let mut cross = [[Matrix3::zeros(); 3]; 2];
         let mut coupled = !diagonal;
         for k in 0..2 {
             let l = 1 - k;
             self.sys[k].auu = on_u(&self.nu_u[k], k);
             self.sys[k].avu = on_u(&self.nu_v[k], k);
-            cross[k] = [on_u(&self.nu_u[k], l), on_u(&self.nu_v[k], l)];
+            cross[k] = [
+                on_u(&self.nu_u[k], l),
+                on_u(&self.nu_v[k], l),
+                self.other_v[k],
+            ];
             coupled |= self.nu_u[k][l].iter().any(|x| *x != 0.0)
-                || self.nu_v[k][l].iter().any(|x| *x != 0.0);
+                || self.nu_v[k][l].iter().any(|x| *x != 0.0)
+                || self.other_v[k].iter().any(|x| *x != 0.0);
         }
         self.cross = coupled.then_some(cross);
     }

@@ -333,6 +333,7 @@ pub(super) fn augmented(b: &S2Builder) -> Full {
             let l = 9 * (1 - k);
             a.fixed_view_mut::<3, 3>(o, l).copy_from(&c[k][0]);
             a.fixed_view_mut::<3, 3>(o + 3, l).copy_from(&c[k][1]);
+            a.fixed_view_mut::<3, 3>(o, l + 3).copy_from(&c[k][2]);
         }
     }
     a
