@@ -380,3 +380,12 @@ CATALOGUE += [
     Bad("centre of flotation far off the hull", vessel_with("gravity = 9.81", "gravity = 9.81\nflotation_center_x = 5000.0"),
         E, ("vessel.flotation_center_x", "±1000 m")),
 ]
+
+CATALOGUE += [
+    Bad("centre of gravity far off the hull", vessel_with("gravity = 9.81", "gravity = 9.81\ncenter_of_gravity = [0.0, 1.0e8, 0.0]"),
+        E, ("vessel.center_of_gravity[1]", "±1000 m")),
+    Bad("nearly singular mass matrix",
+        vessel_with("gravity = 9.81", "gravity = 9.81\nadded_mass = [" + ", ".join(
+            [_ROW] + ["[0.0, -6.3622084999999e6, 0.0, 0.0, 0.0, 0.0]"] + [_ROW] * 4) + "]"), E,
+        ("nearly singular", "condition number")),
+]

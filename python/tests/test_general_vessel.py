@@ -242,3 +242,20 @@ def test_a_vessel_file_with_full_matrices_in_a_scenario(tmp_path):
     a = phsplit.simulate(s.vessel, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
     b = phsplit.simulate(OSV, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
     np.testing.assert_array_equal(a.x, b.x)
+
+
+def test_matrix_entries_can_be_swept():
+    """``vessel.added_mass[i][j]`` addresses one entry (its mirror follows: M_A is symmetric);
+    a wrong number of indices or a row as a value makes the case invalid with a message."""
+    v = phsplit.with_parameters(OSV, {"vessel.added_mass[1][5]": -8.0e6})
+    d = v.to_dict()["vessel"]["added_mass"]
+    assert d[1][5] == d[5][1] == -8.0e6
+    assert v.mass_matrix[1, 5] == pytest.approx(OSV.mass_matrix[1, 5] + 1.1e6, rel=1e-12)
+    ds = phsplit.simulate_many([{"vessel.added_mass[1][5]": x} for x in (-9.1e6, -7.0e6)]
+                               + [{"vessel.added_mass[1]": 1.0}, {"vessel.added_mass[1][5]": [1.0] * 6}],
+                               base=OSV, t_span=(0.0, 10.0), h=0.5, method="sp2", control_start=0.0)
+    assert list(ds.status.values) == ["completed", "completed", "invalid", "invalid"]
+    assert "give two indices" in ds["error"].values[2] and "must be a number" in ds["error"].values[3]
+    a = phsplit.simulate(OSV, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
+    np.testing.assert_array_equal(ds.position.values[0], a.x)
+    assert np.isnan(ds["vessel_added_mass_1_5"].values[3])

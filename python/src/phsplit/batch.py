@@ -35,34 +35,50 @@ import numpy as np
 from . import _core
 from .simulate import Settings, Vessel, settings_to_toml, simulate
 
-_PATH = re.compile(r"^([a-z_]+)\.([a-z_]+)(?:\[([0-9]+)\])?$")
+_PATH = re.compile(r"^([a-z_]+)\.([a-z_]+)(?:\[([0-9]+)\])?(?:\[([0-9]+)\])?$")
+#: Matrices that are symmetric by definition: an off-diagonal entry sets its mirror too.
+_SYMMETRIC = {("vessel", "added_mass"), ("vessel", "damping_matrix")}
 
 
-def _resolve(d: dict, key: str) -> tuple[str, str, int | None]:
-    """Check a parameter path against a vessel's dict: (table, name, index or None)."""
+def _resolve(d: dict, key: str) -> tuple[str, str, tuple[int, ...]]:
+    """Check a parameter path against a vessel's dict: (table, name, indices)."""
     if not isinstance(key, str):
-        raise _core.InvalidInputError(f"a parameter path is a string 'table.name' or 'table.name[i]', got {key!r}")
+        raise _core.InvalidInputError(
+            f"a parameter path is a string 'table.name', 'table.name[i]' or 'table.name[i][j]', got {key!r}")
     m = _PATH.match(key)
     if not m or not isinstance(d.get(m.group(1)), dict) or m.group(2) not in d[m.group(1)]:
         valid = sorted(f"{s}.{k}" for s in d if isinstance(d[s], dict) for k in d[s])
         raise _core.InvalidInputError(
-            f"unknown parameter {key!r}; parameters are table.name or table.name[i], one of: {', '.join(valid)}")
-    sec, name, idx = m.group(1), m.group(2), m.group(3)
+            f"unknown parameter {key!r}; parameters are table.name, table.name[i] or table.name[i][j] "
+            f"(a matrix entry), one of: {', '.join(valid)}")
+    sec, name = m.group(1), m.group(2)
+    idx = tuple(int(g) for g in (m.group(3), m.group(4)) if g is not None)
     cur = d[sec][name]
-    is_vec = isinstance(cur, (list, tuple))
-    if is_vec and idx is None:
-        raise _core.InvalidInputError(f"parameter {key!r} is a {len(cur)}-vector: give an index, e.g. {key}[0]")
-    if not is_vec and idx is not None:
-        raise _core.InvalidInputError(f"parameter {sec}.{name} is a scalar: drop the index in {key!r}")
-    if is_vec and int(idx) >= len(cur):
-        raise _core.InvalidInputError(f"parameter {key!r}: index out of range (0..{len(cur) - 1})")
-    return sec, name, None if idx is None else int(idx)
+    rank = 0
+    if isinstance(cur, (list, tuple)):
+        rank = 2 if cur and all(isinstance(r, (list, tuple)) for r in cur) else 1
+    if len(idx) != rank:
+        if rank == 0:
+            shape = "a scalar: give no index"
+        elif rank == 1:
+            shape = f"a {len(cur)}-vector: give one index, e.g. {sec}.{name}[0]"
+        else:
+            shape = f"a {len(cur)}-row matrix: give two indices, e.g. {sec}.{name}[0][0]"
+        raise _core.InvalidInputError(f"parameter {key!r}: {sec}.{name} is {shape}")
+    if rank >= 1:
+        size = [len(cur)] + ([len(cur[idx[0]])] if rank == 2 and idx[0] < len(cur) else [])
+        for i, n in zip(idx, size):
+            if i >= n:
+                raise _core.InvalidInputError(f"parameter {key!r}: index {i} out of range (0..{n - 1})")
+    return sec, name, idx
 
 
 def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
-    """``base`` with parameters replaced: keys ``table.name`` or ``table.name[i]`` of the vessel
-    file (``vessel``, ``control``, ``initial``, ``external``, …). Unknown paths and bad values
-    raise InvalidInputError."""
+    """``base`` with parameters replaced: keys ``table.name``, ``table.name[i]`` or, for a
+    matrix, ``table.name[i][j]`` of the vessel file (``vessel``, ``control``, ``initial``,
+    ``external``, …). In the symmetric matrices ``vessel.added_mass`` and
+    ``vessel.damping_matrix`` an off-diagonal entry sets its mirror ``[j][i]`` too. Unknown paths
+    and bad values raise InvalidInputError."""
     if not isinstance(base, Vessel):
         raise _core.InvalidInputError(f"base must be a phsplit.Vessel, got {type(base).__name__}")
     if not isinstance(params, Mapping):
@@ -72,11 +88,22 @@ def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
         sec, name, idx = _resolve(d, key)
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
             raise _core.InvalidInputError(f"parameter {key!r} must be a number, got {value!r}")
-        if idx is None:
+        if not idx:
             d[sec][name] = float(value)
+        elif len(idx) == 1:
+            d[sec][name][idx[0]] = float(value)
         else:
-            d[sec][name][idx] = float(value)
+            d[sec][name][idx[0]][idx[1]] = float(value)
+            if (sec, name) in _SYMMETRIC:
+                d[sec][name][idx[1]][idx[0]] = float(value)
     return Vessel.from_dict(d, f"{base.source} with {dict(params)}")
+
+
+def _number_or_nan(v) -> float:
+    """A case's parameter value for its coordinate (a refused non-number shows as NaN)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+        return float("nan")
+    return float(v)
 
 
 def summarize(vessel: Vessel, sol) -> dict[str, Any]:
@@ -167,7 +194,7 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
                "phsplit_vessel": base.to_toml()},
     )
     for k in keys:
-        ds = ds.assign_coords({_coord_name(k): ("case", np.array([c.get(k, np.nan) for c in cases], float),
+        ds = ds.assign_coords({_coord_name(k): ("case", np.array([_number_or_nan(c.get(k, np.nan)) for c in cases], float),
                                                 {"parameter": k})})
     summary_keys = ["position_error_m", "yaw_error_rad", "energy_final_J", "energy_max_J", "peak_force_N",
                     "peak_moment_Nm"]

@@ -242,5 +242,6 @@ def open_sweep(store: str | os.PathLike[str]):
     ds = ds.assign_coords(case_id=("case", np.array(ids)))
     for k in sorted({k for c in params for k in c}):
         name = k.replace(".", "_").replace("[", "_").replace("]", "")
-        ds = ds.assign_coords({name: ("case", np.array([c.get(k, np.nan) for c in params], float), {"parameter": k})})
+        ds = ds.assign_coords({name: ("case", np.array([c.get(k, np.nan) if isinstance(c.get(k), (int, float)) else np.nan
+                                                         for c in params], float), {"parameter": k})})
     return ds

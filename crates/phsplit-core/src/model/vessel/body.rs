@@ -54,6 +54,9 @@ pub struct Body {
     pub kirchhoff: Option<Kirchhoff>,
 }
 
+/// The largest condition number of `M` accepted.
+const MAX_CONDITION: f64 = 1e12;
+
 /// The 3×3 block `(i, j)` of a 6×6 matrix.
 pub fn block(m: &M6, i: usize, j: usize) -> Matrix3<f64> {
     m.fixed_view::<3, 3>(3 * i, 3 * j).into_owned()
@@ -69,6 +72,12 @@ impl Body {
         let rg: Vector3<f64> = p
             .vec3(T, "center_of_gravity", Some([0.0; 3]), "m", Range::Finite)?
             .into();
+        if let Some(i) = (0..3).find(|&i| rg[i].abs() > 1000.0) {
+            return Err(Error::InvalidInput(format!(
+                "vessel.center_of_gravity[{i}] must lie within ±1000 m of the body origin (m, body frame), got {}",
+                rg[i]
+            )));
+        }
         let added = match p.rows(
             T,
             "added_mass",
@@ -105,10 +114,19 @@ impl Body {
         m += added;
         // Symmetric by construction up to the added mass's round-off.
         let m = (m + m.transpose()) * 0.5;
-        let min = m.symmetric_eigenvalues().min();
+        let ev = m.symmetric_eigenvalues();
+        let (min, max) = (ev.min(), ev.max());
         if !(min > 0.0) {
             return Err(Error::InvalidInput(format!(
                 "the mass matrix M = M_RB + M_A (vessel.mass, vessel.inertia, vessel.center_of_gravity, vessel.added_mass) must be positive definite; its smallest eigenvalue is {min:e}"
+            )));
+        }
+        // A vessel's M has a condition number of 1e2 to 1e4 (the OSV's: 1.1e3); beyond 1e12 its
+        // inverse, and every velocity, loses most of its digits.
+        if max / min > MAX_CONDITION {
+            return Err(Error::InvalidInput(format!(
+                "the mass matrix M = M_RB + M_A is nearly singular: its eigenvalues span {min:e} to {max:e} (condition number {:.1e} > {MAX_CONDITION:.0e}); check vessel.added_mass and vessel.center_of_gravity",
+                max / min
             )));
         }
         let paper_form = {
@@ -272,6 +290,22 @@ mod tests {
         assert!(!Body::new(6.3e6, t, Vector3::zeros(), &a)
             .unwrap()
             .is_diagonal());
+        // Nearly singular: an added mass that leaves almost nothing of the sway mass.
+        let a = M6::from_diagonal(&V6::from_column_slice(&[
+            0.0,
+            -6.3e6 * (1.0 - 1e-14),
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ]));
+        let e = Body::new(6.3e6, t, Vector3::zeros(), &a)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("nearly singular") && e.contains("condition number"),
+            "{e}"
+        );
         // A negative added mass larger than the body's: not positive definite.
         let a = M6::from_diagonal(&V6::from_column_slice(&[0.0, -7e6, 0.0, 0.0, 0.0, 0.0]));
         let e = Body::new(6.3e6, t, Vector3::zeros(), &a)
