@@ -259,3 +259,21 @@ def test_matrix_entries_can_be_swept():
     a = phsplit.simulate(OSV, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
     np.testing.assert_array_equal(ds.position.values[0], a.x)
     assert np.isnan(ds["vessel_added_mass_1_5"].values[3])
+
+
+def test_a_sub_flow_that_gives_up_says_why():
+    """A run that fails because a sub-flow gave up (rather than return an unconverged result)
+    says which and what to do; the run ends cleanly with what it had."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", phsplit.StepSizeWarning)
+        s = phsplit.simulate(OSV, (0.0, 3600.0), 500.0, "sp2", control_start=0.0)
+        assert s.status == "failed" and len(s.t) >= 1
+        assert "Kirchhoff's equations" in s.failure and "take a shorter step" in s.failure
+        t = phsplit.Vessel.paper().to_dict()
+        t["damping_quadratic"] = {"coefficients": [1e6, 1e6, 1e6, 1e10, 1e11, 1e11]}
+        s = phsplit.simulate(phsplit.Vessel.from_dict(t), (0.0, 2000.0), 100.0, "sp2", control_start=0.0)
+        assert s.status == "failed"
+        assert "fixed point of flow S2's non-affine" in s.failure and "take a shorter step" in s.failure
+        # a run that overflows without a sub-flow giving up says only that
+        s = phsplit.simulate(phsplit.Vessel.paper(), (0.0, 200.0), 4.0, "rk4", control_start=0.0)
+        assert s.status == "failed" and s.failure.endswith("the state became non-finite")

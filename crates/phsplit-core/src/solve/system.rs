@@ -62,6 +62,11 @@ pub trait Model {
     fn energy(&self, s: &Self::State) -> f64;
     /// Whether the state is usable (finite).
     fn is_finite(&self, s: &Self::State) -> bool;
+    /// Why the last step made the state non-finite, when a sub-flow knows (it gave up rather
+    /// than return an unconverged result): said with the run's failure.
+    fn failure_reason(&self) -> Option<String> {
+        None
+    }
     /// Whether the model's field is the same on steps starting at `t_a` and `t_b` (no switch
     /// between them): sub-steps of the same flow may then be merged across the boundary.
     fn same_field(&self, t_a: f64, t_b: f64) -> bool;

@@ -142,11 +142,11 @@ impl<'m, M: Model> Recorder<'m, M> {
     }
     /// End the run: the state became non-finite during step `step`, which started at `t`.
     pub(crate) fn fail(mut self, step: usize, t: f64) -> Trajectory<M::State> {
-        self.traj.status = Status::Failed {
-            step,
-            t,
-            reason: "the state became non-finite".into(),
+        let reason = match self.model.failure_reason() {
+            Some(why) => format!("the state became non-finite: {why}"),
+            None => "the state became non-finite".into(),
         };
+        self.traj.status = Status::Failed { step, t, reason };
         self.traj
     }
     /// End the run at the caller's request after `steps` steps, at `t` with the state `y` (saved

@@ -116,6 +116,8 @@ impl Body {
         let m = (m + m.transpose()) * 0.5;
         let ev = m.symmetric_eigenvalues();
         let (min, max) = (ev.min(), ev.max());
+        // Written so that a NaN eigenvalue is refused too.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(min > 0.0) {
             return Err(Error::InvalidInput(format!(
                 "the mass matrix M = M_RB + M_A (vessel.mass, vessel.inertia, vessel.center_of_gravity, vessel.added_mass) must be positive definite; its smallest eigenvalue is {min:e}"

@@ -83,6 +83,20 @@ pub struct VesselSystem<'a> {
     forced: bool,
     /// Whether a component's forcing depends on the state (else one pass solves the stages).
     forced_stateful: bool,
+    /// Why a sub-flow gave up (a [`GaveUp`] code; 0: none), for the run's failure message.
+    gave_up: std::sync::Arc<std::sync::atomic::AtomicU8>,
+}
+
+/// Why a sub-flow gave up rather than return an unconverged result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub(crate) enum GaveUp {
+    /// Kirchhoff's flow S1 did not converge, even in 1024 sub-steps.
+    Kirchhoff = 1,
+    /// The fixed point of flow S2's forcing did not converge in its passes.
+    Forcing = 2,
+    /// Flow S2's stage system was singular.
+    Singular = 3,
 }
 
 impl<'a> VesselSystem<'a> {
@@ -117,7 +131,18 @@ impl<'a> VesselSystem<'a> {
                 .forces
                 .iter()
                 .any(|f| f.forced() && f.forcing_uses_state()),
+            gave_up: Default::default(),
         }
+    }
+
+    /// Record why a sub-flow gave up (the first reason of a run is kept).
+    pub(crate) fn give_up(&self, why: GaveUp) {
+        let _ = self.gave_up.compare_exchange(
+            0,
+            why as u8,
+            std::sync::atomic::Ordering::Relaxed,
+            std::sync::atomic::Ordering::Relaxed,
+        );
     }
 
     /// Whether flow S2 has a forcing part (a non-affine or time-dependent component), so that
@@ -482,6 +507,7 @@ impl<'a> VesselSystem<'a> {
                 s.m = u.fixed_rows::<3>(3).into_owned();
                 s.q = q;
             } else {
+                self.give_up(GaveUp::Kirchhoff);
                 s.p = Vector3::from_element(f64::NAN);
                 s.m = s.p;
             }
@@ -504,6 +530,15 @@ impl Model for VesselSystem<'_> {
     }
     fn is_finite(&self, s: &VesselState) -> bool {
         s.is_finite()
+    }
+    fn failure_reason(&self) -> Option<String> {
+        let code = self.gave_up.load(std::sync::atomic::Ordering::Relaxed);
+        Some(match code {
+            1 => "flow S1 (Kirchhoff's equations for the general mass matrix) did not converge even in 1024 sub-steps: the rotation is far too fast for the step; take a shorter step".into(),
+            2 => "the fixed point of flow S2's non-affine or time-dependent forces (quadratic or cross-flow drag, wind, waves, pipe, thrusters) did not converge: they change too much within the step; take a shorter step".into(),
+            3 => "flow S2's collocation stage system was singular; take a shorter step".into(),
+            _ => return None,
+        })
     }
     fn same_field(&self, t_a: f64, t_b: f64) -> bool {
         self.control_on(t_a) == self.control_on(t_b)

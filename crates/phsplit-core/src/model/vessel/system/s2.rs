@@ -1,12 +1,19 @@
 //! Flow S2 of the vessel over a sub-step (paper §3.4.2; docs/model.md §3.3, §3.5, §3.7): the
 //! exact flow of the two block systems (matrix exponential, ledger by the Van Loan Gramian),
 //! their Gauss collocation (the structured 3×3 solve, ledger by Gauss quadrature), and the
-//! Gauss collocation of S2 with a forcing part (time-dependent or non-affine components).
-//! The assembly of S2 from the components is `system.rs`'s.
+//! Gauss collocation of S2 with a forcing part (time-dependent or non-affine components); and
+//! the same three for S2 as one coupled 18-dimensional system, where the mass matrix or a force
+//! couples translation and rotation (docs/model.md §5.14). A solve that gives up (a singular
+//! stage system, a fixed point that does not converge) yields NaN and records why
+//! ([`GaveUp`]), which the run's failure message says. The assembly of S2 from the components
+//! is `system.rs`'s.
+
+// Stage loops index the Butcher tableau `a_ij`, `b_i` and the blocks as the formulas write them.
+#![allow(clippy::needless_range_loop)]
 
 use super::super::forces::{Forcing, Frozen, Rows, S2Builder, Sys};
 use super::super::state::VesselState;
-use super::{LinearFlow, VesselSystem};
+use super::{GaveUp, LinearFlow, VesselSystem};
 use crate::flows::affine;
 use crate::flows::collocation::{self as gauss, Blocks, Z3};
 use crate::solve::Work;
@@ -159,6 +166,7 @@ impl VesselSystem<'_> {
                     rhs.fixed_rows_mut::<10>(10 * i).copy_from(&r);
                 }
                 let Some(y) = lus[k].solve(&rhs) else {
+                    self.give_up(GaveUp::Singular);
                     return nan;
                 };
                 for i in 0..s {
@@ -196,6 +204,8 @@ impl VesselSystem<'_> {
             }
             prev_r = Some(r);
             if !change.is_finite() {
+                // The fixed point diverged (or a stage overflowed).
+                self.give_up(GaveUp::Forcing);
                 return nan;
             }
             // Converged: the stages no longer move (a forcing independent of the state
@@ -205,6 +215,7 @@ impl VesselSystem<'_> {
                 break;
             }
             if it + 1 == FORCED_MAX_ITERATIONS && change > 1e-10 {
+                self.give_up(GaveUp::Forcing);
                 return nan;
             }
             // Without a state-dependent forcing the first pass is the solution.
@@ -510,6 +521,7 @@ impl VesselSystem<'_> {
                 rhs.fixed_rows_mut::<19>(19 * i).copy_from(&r);
             }
             let Some(y) = lu.solve(&rhs) else {
+                self.give_up(GaveUp::Singular);
                 return nan;
             };
             let r: [FullVector; 3] = std::array::from_fn(|i| {
@@ -544,6 +556,8 @@ impl VesselSystem<'_> {
             }
             prev_r = Some(r);
             if !change.is_finite() {
+                // The fixed point diverged (or a stage overflowed).
+                self.give_up(GaveUp::Forcing);
                 return nan;
             }
             if !stateful
@@ -553,6 +567,7 @@ impl VesselSystem<'_> {
                 break;
             }
             if it + 1 == FORCED_MAX_ITERATIONS && change > 1e-10 {
+                self.give_up(GaveUp::Forcing);
                 return nan;
             }
             last_change = change;
