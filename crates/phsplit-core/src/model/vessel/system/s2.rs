@@ -131,7 +131,7 @@ impl VesselSystem<'_> {
             }
         });
         let stateful = self.forced_stateful;
-        let mut last_change = f64::INFINITY;
+        let (mut last_change, mut last_parts) = (f64::INFINITY, f64::INFINITY);
         // Aitken's relaxation of the fixed point (B. M. Irons, R. C. Tuck, Int. J. Numer. Meth.
         // Eng. 1 (1969) 275–277; in the form of U. Küttler, W. A. Wall, Comput. Mech. 43 (2008)
         // 61–72, eq. 44): x ← x + ω r with r = G(x) − x and ω ← −ω r_oldᵀ(r − r_old)/|r − r_old|².
@@ -147,7 +147,7 @@ impl VesselSystem<'_> {
                     g[i].add(&self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true)));
                 }
             }
-            let mut change: f64 = 0.0;
+            let (mut change, mut parts): (f64, f64) = (0.0, 0.0);
             let mut r = [[SVector::<f64, 10>::zeros(); 3]; 2];
             for k in 0..2 {
                 let gt: [SVector<f64, 10>; 3] = std::array::from_fn(|j| {
@@ -191,13 +191,13 @@ impl VesselSystem<'_> {
             for k in 0..2 {
                 for i in 0..s {
                     let yi = ys[k][i] + r[k][i] * omega;
-                    let size = yi.amax().max(f64::MIN_POSITIVE);
-                    let res = r[k][i].amax() / size;
+                    let (res, part) = relative_change(r[k][i].as_slice(), yi.as_slice(), 9);
                     change = if res.is_nan() || change.is_nan() {
                         f64::NAN
                     } else {
                         change.max(res)
                     };
+                    parts = parts.max(part);
                     ys[k][i] = yi;
                     stage_z[i][k] = unpack(&yi, k);
                 }
@@ -208,9 +208,12 @@ impl VesselSystem<'_> {
                 self.give_up(GaveUp::Forcing);
                 return nan;
             }
-            // Converged: the stages no longer move (a forcing independent of the state
-            // converges at the second pass), or they stopped improving at round-off.
-            if it > 0 && (change <= 4.0 * f64::EPSILON || (change >= last_change && change < 1e-12))
+            // Converged: the stages no longer move, every part of them (a forcing independent of
+            // the state converges at the second pass), or, at round-off of the whole, their parts
+            // stopped improving.
+            if it > 0
+                && (parts <= 4.0 * f64::EPSILON
+                    || (change < 1e-12 && change >= last_change && parts >= last_parts))
             {
                 break;
             }
@@ -222,7 +225,7 @@ impl VesselSystem<'_> {
             if !stateful {
                 break;
             }
-            last_change = change;
+            (last_change, last_parts) = (change, parts);
         }
         for i in 0..s {
             g[i] = fixed[i];
@@ -503,7 +506,7 @@ impl VesselSystem<'_> {
             }
             g
         };
-        let (mut omega, mut last_change) = (1.0, f64::INFINITY);
+        let (mut omega, mut last_change, mut last_parts) = (1.0, f64::INFINITY, f64::INFINITY);
         let mut prev_r: Option<[FullVector; 3]> = None;
         let mut g = [Forcing::new(); 3];
         for it in 0..FORCED_MAX_ITERATIONS {
@@ -542,15 +545,16 @@ impl VesselSystem<'_> {
                     omega = (-omega * num / den).clamp(0.05, 2.0);
                 }
             }
-            let mut change: f64 = 0.0;
+            let (mut change, mut parts): (f64, f64) = (0.0, 0.0);
             for i in 0..s {
                 let yi = ys[i] + r[i] * omega;
-                let res = r[i].amax() / yi.amax().max(f64::MIN_POSITIVE);
+                let (res, part) = relative_change(r[i].as_slice(), yi.as_slice(), 18);
                 change = if res.is_nan() || change.is_nan() {
                     f64::NAN
                 } else {
                     change.max(res)
                 };
+                parts = parts.max(part);
                 ys[i] = yi;
                 stage_z[i] = unpack_full(&yi.component_mul(scale));
             }
@@ -560,9 +564,11 @@ impl VesselSystem<'_> {
                 self.give_up(GaveUp::Forcing);
                 return nan;
             }
+            // As in the block systems' collocation.
             if !stateful
                 || (it > 0
-                    && (change <= 4.0 * f64::EPSILON || (change >= last_change && change < 1e-12)))
+                    && (parts <= 4.0 * f64::EPSILON
+                        || (change < 1e-12 && change >= last_change && parts >= last_parts)))
             {
                 break;
             }
@@ -570,7 +576,7 @@ impl VesselSystem<'_> {
                 self.give_up(GaveUp::Forcing);
                 return nan;
             }
-            last_change = change;
+            (last_change, last_parts) = (change, parts);
         }
         for i in 0..s {
             g[i] = total(i, &stage_z[i]);
@@ -593,6 +599,34 @@ impl VesselSystem<'_> {
         }
         (z1, work)
     }
+}
+
+/// The size of a fixed-point update `r` at the iterate `y` (the first `n` entries: momenta,
+/// positions or `mu`, integral states, in 3-vectors): relative to the whole vector, and the
+/// largest relative to each 3-vector (floored at 1e-12 of the whole). The first says when round-off
+/// is reached; the second that a small part (the velocities, when an integral state is large)
+/// has converged too, since the ledger books its power.
+fn relative_change(r: &[f64], y: &[f64], n: usize) -> (f64, f64) {
+    let amax = |v: &[f64]| {
+        v.iter().fold(0.0f64, |m, x| {
+            if x.abs() > m || x.is_nan() {
+                x.abs()
+            } else {
+                m
+            }
+        })
+    };
+    let size = amax(&y[..n]).max(f64::MIN_POSITIVE);
+    let whole = amax(r) / size;
+    let mut parts: f64 = 0.0;
+    for g in 0..n / 3 {
+        let (rg, yg) = (&r[3 * g..3 * g + 3], &y[3 * g..3 * g + 3]);
+        parts = parts.max(amax(rg) / amax(yg).max(size * 1e-12));
+    }
+    if whole.is_nan() || parts.is_nan() {
+        return (f64::NAN, f64::NAN);
+    }
+    (whole, parts)
 }
 
 /// Diagonal balancing `z = S z̃` of a block system for the exponential: momenta become
