@@ -22,14 +22,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 
-def S(r):
-    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
-
-
-def euler_zyx(Q):
-    return np.array([np.arctan2(Q[2, 1], Q[2, 2]),
-                     np.arctan2(-Q[2, 0], np.hypot(Q[0, 0], Q[1, 0])),
-                     np.arctan2(Q[1, 0], Q[0, 0])])
+# The cross-product matrix, ZYX Euler angles and Pi_e: the small kinematic helpers of the
+# other independent model (tests/reference.py), shared; the dynamics below are not.
+from reference import euler_zyx, hat as S  # noqa: E402
+from reference import pi_e as euler_rate_inverse  # noqa: E402
 
 
 def rot_zyx(th):
@@ -38,14 +34,6 @@ def rot_zyx(th):
     ry = np.array([[ct, 0, st], [0, 1, 0], [-st, 0, ct]])
     rz = np.array([[cp, -sp, 0], [sp, cp, 0], [0, 0, 1]])
     return rz @ ry @ rx
-
-
-def euler_rate_inverse(th):
-    """Pi_e(theta) with omega_spatial = Pi_e theta' (ZYX)."""
-    _, t, p = th
-    return np.array([[np.cos(t) * np.cos(p), -np.sin(p), 0.0],
-                     [np.cos(t) * np.sin(p), np.cos(p), 0.0],
-                     [-np.sin(t), 0.0, 1.0]])
 
 
 class Vessel:

@@ -82,23 +82,7 @@ pub fn read_matrix(p: &mut Params) -> crate::Result<SMatrix<f64, 6, 6>> {
 /// `≥ −1e-12` of its largest entry); the message names the matrix and the failing value.
 pub fn check_psd(d: &SMatrix<f64, 6, 6>, name: &str) -> crate::Result<()> {
     let scale = d.amax();
-    let asym = (d - d.transpose()).amax();
-    if asym > 1e-12 * scale {
-        let (mut bi, mut bj, mut worst) = (0, 0, 0.0);
-        for i in 0..6 {
-            for j in 0..6 {
-                let x = (d[(i, j)] - d[(j, i)]).abs();
-                if x > worst {
-                    (bi, bj, worst) = (i, j, x);
-                }
-            }
-        }
-        return Err(Error::InvalidInput(format!(
-            "{name} must be symmetric: entry [{bi}][{bj}] = {} but [{bj}][{bi}] = {}",
-            d[(bi, bj)],
-            d[(bj, bi)]
-        )));
-    }
+    crate::model::vessel::body::check_symmetric(d, name)?;
     let min = d.symmetric_eigenvalues().min();
     if min < -1e-12 * scale {
         return Err(Error::InvalidInput(format!(
