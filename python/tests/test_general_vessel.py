@@ -291,3 +291,23 @@ def test_the_ledger_closes_at_long_steps_with_quadratic_damping(h, method):
             s = phsplit.simulate(v, (0.0, 1200.0), h, method, control_start=0.0)
             assert s.status == "completed", s.failure
             assert s.ledger.relative_residual().max() < 1e-10
+
+
+def test_a_conservative_run_has_a_small_relative_residual():
+    """Without damping or control nothing is booked; dH is then round-off of H, and the
+    relative residual says so (it was 1.0 whatever the run did), while a real imbalance of
+    that size relative to H would still show."""
+    t = OSV.to_dict()
+    t["vessel"]["damping_translational"] = [0.0] * 3
+    t["vessel"]["damping_rotational"] = [0.0] * 3
+    del t["crossflow_drag"]
+    v = phsplit.Vessel.from_dict(t)
+    y0 = v.initial_state(velocity=[1.0, 0.3, 0.0], angular_velocity=[0.01, 0.0, 0.02])
+    s = phsplit.simulate(v, (0.0, 200.0), 0.5, "sp2", control_start=None, initial=y0)
+    assert s.status == "completed"
+    assert np.abs(s.energy - s.energy[0]).max() < 1e-12 * s.energy[0]
+    assert s.ledger.relative_residual().max() < 1e-10
+    bad = phsplit.Ledger(dH=s.ledger.dH + 1e-9 * s.energy[0], supplied=s.ledger.supplied,
+                         dissipated=s.ledger.dissipated, by_account=s.ledger.by_account,
+                         kinds=s.ledger.kinds, level=s.ledger.level)
+    assert bad.relative_residual()[1:].min() > 1e-6  # 1e-9 of H shows as 5e-6

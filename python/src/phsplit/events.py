@@ -342,7 +342,7 @@ def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
         t=t, x=pick["x"], euler=pick["euler"], quaternion=pick["quaternion"], Q=pick["Q"], p=pick["p"], m=pick["m"],
         mu=pick["mu"], phi_th=pick["phi_th"], phi_x=pick["phi_x"], energy=e,
         ledger=Ledger(dH=np.concatenate([[0.0], np.diff(e)]), supplied=sup, dissipated=dis, by_account=by_account,
-                      kinds=dict(kinds)),
+                      kinds=dict(kinds), level=Ledger.level_of(e)),
         orthogonality_defect=pick["orthogonality_defect"], status=status, method=tmpl.method, h=settings.h,
         control_start=settings.control_start, steps=steps, failure=failure,
         last_good_state=src[-1][0].state(src[-1][1]), meta=dict(tmpl.meta),

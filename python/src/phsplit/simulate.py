@@ -170,6 +170,14 @@ class Ledger:
     dissipated: np.ndarray
     by_account: dict[str, np.ndarray] = field(default_factory=dict)
     kinds: dict[str, str] = field(default_factory=dict)
+    #: ``|H_n| + |H_{n-1}|`` per interval (the terms whose difference is ``dH``), or None.
+    level: np.ndarray | None = None
+
+    @staticmethod
+    def level_of(energy: np.ndarray) -> np.ndarray:
+        """``|H_n| + |H_{n-1}|`` per saved interval (the first entry zero)."""
+        e = np.abs(np.asarray(energy, dtype=float))
+        return np.concatenate([[0.0], e[1:] + e[:-1]]) if len(e) else e
 
     @property
     def residual(self) -> np.ndarray:
@@ -179,9 +187,15 @@ class Ledger:
     def relative_residual(self) -> np.ndarray:
         """Residual over the size of the terms of each interval's balance: ``|dH|`` plus each
         account's ``|booked|`` (two ports that nearly cancel, a pipe pulling against the thrusters,
-        count with their own sizes: floating point cannot resolve their sum better than that)."""
+        count with their own sizes: floating point cannot resolve their sum better than that),
+        and at least ``1e-4 (|H_n| + |H_{n-1}|)``: ``dH`` is a difference of two energies, each
+        evaluated from a state that carries round-off, so a residual below about 1e-14 of ``|H|``
+        (a few tens of ulps) is round-off, not a ledger error. Without that floor a conservative
+        run, which books nothing, showed 1.0 however well it kept H."""
         booked = sum((np.abs(v) for v in self.by_account.values()), np.zeros_like(self.dH))
         scale = np.abs(self.dH) + np.maximum(booked, np.abs(self.supplied) + np.abs(self.dissipated))
+        if self.level is not None and len(self.level) == len(scale):
+            scale = np.maximum(scale, 1e-4 * np.asarray(self.level))
         with np.errstate(invalid="ignore", divide="ignore"):
             r = np.abs(self.residual) / scale
         return np.where(scale > 0, r, 0.0)
@@ -660,7 +674,7 @@ def simulate(
         energy=e,
         ledger=Ledger(dH=dH, supplied=raw["supplied"], dissipated=raw["dissipated"],
                       by_account={n: raw["booked"][:, k] for k, n in enumerate(names)},
-                      kinds=dict(zip(names, raw["account_kinds"]))),
+                      kinds=dict(zip(names, raw["account_kinds"])), level=Ledger.level_of(e)),
         orthogonality_defect=raw["orthogonality_defect"], status=raw["status"],
         method=info["name"], h=used["h"], control_start=used["control_start"], steps=raw["steps"],
         failure=raw.get("failure"), last_good_state=raw["last_good"],
