@@ -55,7 +55,8 @@ def main() -> int:
     finally:
         shutil.rmtree(store, ignore_errors=True)
     lines = ["# Sweep throughput", "",
-             f"{n} one-hour SP2 cases (h = 0.5 s, 7,200 steps each, exact S2, ledger on, every 20th step saved, "
+             f"{n} one-hour SP2 cases (h = 0.5 s, 7,200 steps each, S2 {phsplit.Settings().linear_flow} "
+             f"(the default), ledger on, every 20th step saved, "
              f"summary per case; default settings, so with the projection onto the restoring invariant, "
              f"docs/model.md §3.6), {cores} logical cores.", "", "| how | wall time [s] | cases per second |",
              "|---|---|---|"]

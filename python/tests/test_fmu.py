@@ -96,7 +96,7 @@ def test_fig2_in_fmpy_is_phsplit_simulate(fig2_fmu):
     """Communication step 1 s, twice the internal step: the FMU gives simulate's numbers."""
     r = simulate_fmu(str(fig2_fmu), output_interval=1.0, output=OUTPUTS)
     assert r["time"][0] == 0.0 and r["time"][-1] == 200.0
-    sol = phsplit.simulate(phsplit.Vessel.paper())
+    sol = phsplit.simulate(phsplit.Vessel.paper(), linear_flow="exact")  # the Fig. 2 scenario's
     assert_close(r, reference_columns(sol, r["time"]), 1e-12)
 
 
@@ -130,7 +130,7 @@ def test_variable_communication_steps_follow_simulate(fig2_fmu, tmp_path):
     s.terminate()
     s.freeInstance()
     got = dict(zip(OUTPUTS, np.array(rows).T))
-    sol = phsplit.simulate(phsplit.Vessel.paper(), t_span=(0.0, t))
+    sol = phsplit.simulate(phsplit.Vessel.paper(), t_span=(0.0, t), linear_flow="exact")
     assert_close(got, reference_columns(sol, np.array(times)), 1e-12)
 
 
@@ -155,7 +155,7 @@ def test_inputs_act_like_the_vessel_file(tmp_path):
     tables["control"] = dict(base["control"], position_reference=[790.0, 25.0, 0.0],
                              euler_reference=[0.0, 0.0, 0.2])
     tables["current"] = {"velocity": [0.3, -0.2, 0.0]}
-    sol = phsplit.simulate(phsplit.Vessel.from_dict(tables), t_span=(0.0, t_end))
+    sol = phsplit.simulate(phsplit.Vessel.from_dict(tables), t_span=(0.0, t_end), linear_flow="exact")
     path = fmu.export(None, tmp_path / "v.fmu")
     common = {"external.point[0]": -40.0, "external.point[1]": 5.0, "external.point[2]": 3.0,
               "setpoint.x": 790.0, "setpoint.y": 25.0, "setpoint.heading": 0.2,
@@ -393,7 +393,7 @@ def test_without_the_ledger_the_trajectory_is_the_same(fig2_fmu):
     cols = ["position.x", "euler.pitch", "energy.stored", "energy.supplied", "ledger.control"]
     a = simulate_fmu(str(fig2_fmu), stop_time=80.0, output_interval=1.0, output=cols)
     b = simulate_fmu(str(fig2_fmu), stop_time=80.0, output_interval=1.0, output=cols, start_values={"ledger": False})
-    sol = phsplit.simulate(phsplit.Vessel.paper(), t_span=(0.0, 80.0), ledger=False)
+    sol = phsplit.simulate(phsplit.Vessel.paper(), t_span=(0.0, 80.0), ledger=False, linear_flow="exact")
     i = np.searchsorted(sol.t, b["time"])
     assert_close(b, {"position.x": sol.x[i, 0], "euler.pitch": sol.euler[i, 1], "energy.stored": sol.energy[i]},
                  1e-12, "ledger off vs simulate: ")
@@ -426,10 +426,10 @@ def test_an_input_changed_mid_run_is_simulate_in_two_legs(fig2_fmu, tmp_path):
         got.append(s.getReal([vr[c] for c in cols]))
     s.terminate()
     s.freeInstance()
-    first = phsplit.simulate(phsplit.Vessel.paper(), t_span=(0.0, 60.0))
+    first = phsplit.simulate(phsplit.Vessel.paper(), t_span=(0.0, 60.0), linear_flow="exact")
     tables = phsplit.Vessel.paper().to_dict()
     tables["external"] = {"force": [2e5, -1e5, 0.0]}
-    second = phsplit.simulate(phsplit.Vessel.from_dict(tables), t_span=(60.0, 100.0), initial=first.state(-1),
+    second = phsplit.simulate(phsplit.Vessel.from_dict(tables), t_span=(60.0, 100.0), initial=first.state(-1), linear_flow="exact",
                               _continuing=True)
     got = np.array(got)
     i = np.searchsorted(second.t, np.arange(61.0, 101.0))

@@ -127,7 +127,7 @@ def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
 
 # Issue 13, item 1: a case's identity covers everything that determines its result.
 OTHER_VALUE = {"t_span": (0.0, 20.0), "h": 0.25, "method": "rk4", "control_start": None, "outer": "conservative",
-               "save_every": 5, "linear_flow": "gauss", "ledger": False, "project_invariants": False}
+               "save_every": 5, "linear_flow": "exact", "ledger": False, "project_invariants": False}
 
 
 def test_every_setting_vessel_and_version_enters_the_case_id(monkeypatch):

@@ -65,7 +65,8 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--save-every", type=int, help="save every k-th step (decimation)")
     s.add_argument("--control-start", help="override the controller's start time, s, or 'never'")
     s.add_argument("--linear-flow", choices=["exact", "gauss"],
-                   help="flow S2 exactly (matrix exponentials, the default) or by Gauss collocation (faster)")
+                   help="flow S2 by Gauss collocation (the library's default) or exactly (matrix "
+                   "exponentials, the paper's; the default of the Fig. 2 scenario)")
     s.add_argument("--no-plot", action="store_true", help="skip the PNG")
     sub.add_parser("methods", help="list the integration methods")
     sub.add_parser("vessels", help="list the shipped vessels (phsplit.Vessel.preset) and their sources")

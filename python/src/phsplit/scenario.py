@@ -1,7 +1,8 @@
 """Scenario files (TOML): what to simulate, validated with messages that name the problem.
 
 A scenario has a ``[simulation]`` table (every key optional; the defaults are the paper's
-Fig. 2 run, shared with :func:`phsplit.simulate`) and optionally a vessel: a path
+Fig. 2 run with flow S2 by Gauss collocation, shared with :func:`phsplit.simulate`; the
+paper's exact S2 is ``linear_flow = "exact"``) and optionally a vessel: a path
 (``vessel = "my_vessel.toml"``, relative to the scenario file), a shipped vessel by name
 (``vessel = "osv"``; ``phsplit vessels``), or the paper's when absent.
 Any table of a vessel file given in the scenario (``[vessel]``, ``[control]``, ``[initial]``,
@@ -18,7 +19,7 @@ settings and the vessel, and names a key nobody reads, with the nearest valid on
     control_start = 50.0    # s, or "never"
     outer = "dissipative"   # or "conservative"
     save_every = 1
-    linear_flow = "exact"   # or "gauss"
+    linear_flow = "gauss"   # the default, or "exact" (the paper's)
 
     [external]              # a constant load at a point of the hull
     force = [2.0e5, 0.0, 0.0]   # N
@@ -63,8 +64,9 @@ class Scenario:
 
     @classmethod
     def paper_fig2(cls) -> "Scenario":
-        """The paper's Fig. 2: t in [0, 200], controller on at t = 50, SP4 with h = 0.5."""
-        return cls(vessel=Vessel.paper())
+        """The paper's Fig. 2: t in [0, 200], controller on at t = 50, SP4 with h = 0.5, and the
+        paper's exact flow S2 (the library's default is Gauss collocation, README)."""
+        return cls(vessel=Vessel.paper(), settings=Settings(linear_flow="exact"))
 
     # The settings, for reading and overriding (the CLI's options).
     def __getattr__(self, key: str) -> Any:
