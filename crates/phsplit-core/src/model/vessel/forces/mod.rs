@@ -240,6 +240,24 @@ impl S2Builder {
     /// Turn the rows on the velocities into rows on the momenta, `ν = M⁻¹u` with the blocks
     /// `minv[j][l]` of `M⁻¹`; decide whether the systems are coupled.
     pub(crate) fn finish(&mut self, minv: &[[Matrix3<f64>; 2]; 2], diagonal: bool) {
+        let nonzero = |m: &Matrix3<f64>| m.iter().any(|x| *x != 0.0);
+        let crossing = (0..2).any(|k| {
+            nonzero(&self.nu_u[k][1 - k])
+                || nonzero(&self.nu_v[k][1 - k])
+                || nonzero(&self.other_v[k])
+        });
+        if diagonal && !crossing {
+            // `M⁻¹` diagonal and nothing coupling: each system's rows scale by its own diagonal
+            // (the numbers of the general products below, without the products by zero blocks).
+            for k in 0..2 {
+                let d = minv[k][k].diagonal();
+                let cols = |m: &Matrix3<f64>| Matrix3::from_fn(|i, j| m[(i, j)] * d[j]);
+                self.sys[k].auu = cols(&self.nu_u[k][k]);
+                self.sys[k].avu = cols(&self.nu_v[k][k]);
+            }
+            self.cross = None;
+            return;
+        }
         let on_u = |r: &[Matrix3<f64>; 2], l: usize| r[0] * minv[0][l] + r[1] * minv[1][l];
         let mut cross = [[Matrix3::zeros(); 3]; 2];
         let mut coupled = !diagonal;
