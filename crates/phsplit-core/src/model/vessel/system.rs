@@ -18,6 +18,7 @@ use crate::methods::Flow;
 use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
 use nalgebra::{Matrix3, SVector, Vector3};
 
+mod s1;
 mod s2;
 
 /// How flow S2 (linear) is integrated.
@@ -389,19 +390,6 @@ impl<'a> VesselSystem<'a> {
         d
     }
 
-    /// Flow S1's momentum rates and the angular velocity: Kirchhoff's `p' = p × ω`,
-    /// `m' = m × ω + p × v` (docs/model.md §3.8), which for `M` of the paper's form is the free
-    /// rigid body's `m' = m × ω` with `p` carried along (`p × v = 0`).
-    fn s1_rates(&self, s: &VesselState) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
-        let body = &self.vessel.body;
-        if body.is_diagonal() {
-            let w = body.free.omega(&s.m);
-            return (-w.cross(&s.p), -w.cross(&s.m), w);
-        }
-        let [v, w] = body.velocity(&s.p, &s.m);
-        (s.p.cross(&w), s.m.cross(&w) + s.p.cross(&v), w)
-    }
-
     /// The power per account at `s` and time `t` (W).
     pub fn power(&self, s: &VesselState, t: f64, on: bool) -> Work {
         let fr = self.frozen(s, on);
@@ -462,61 +450,6 @@ impl<'a> VesselSystem<'a> {
                 )
             })
             .collect()
-    }
-
-    /// Flow S1 over `h` (paper §3.4.1; docs/model.md §3.8); `mu, x, phi` unchanged. For `M` of
-    /// the paper's form, exact: the free rigid body with a Magnus attitude of the given order,
-    /// `p(h) = Q(h)ᵀ Q0 p0`. For a general `M`, Kirchhoff's equations by Gauss collocation of the
-    /// same order (H kept to round-off) with the attitude by Runge–Kutta–Munthe-Kaas; a step too
-    /// long for its Newton iteration (`h|ω| ≳ 1`) is taken in 2, 4, … up to 1024 equal sub-steps;
-    /// beyond that the state becomes NaN and the run stops with what it had.
-    pub fn flow_s1(&self, s: &mut VesselState, h: f64, order: MagnusOrder) {
-        if let Some(k) = &self.vessel.body.kirchhoff {
-            let stages = match order {
-                MagnusOrder::Two => 1,
-                MagnusOrder::Four => 2,
-                MagnusOrder::Six => 3,
-            };
-            let mut u = nalgebra::SVector::<f64, 6>::zeros();
-            const MAX_S1_HALVINGS: usize = 10;
-            u.fixed_rows_mut::<3>(0).copy_from(&s.p);
-            u.fixed_rows_mut::<3>(3).copy_from(&s.m);
-            // Newton's method on the stages converges for h|ω| up to about 1; a longer step is
-            // taken as 2, 4, … equal sub-steps (each keeps H, so the flow still does).
-            let mut q = s.q;
-            let mut done = false;
-            for k2 in 0..=MAX_S1_HALVINGS {
-                let n = 1usize << k2;
-                let dt = h / n as f64;
-                let (mut uu, mut qq) = (u, q);
-                let ok = (0..n).all(|_| match k.flow(&uu, &qq, dt, stages) {
-                    Some((u1, q1)) => {
-                        (uu, qq) = (u1, q1);
-                        true
-                    }
-                    None => false,
-                });
-                if ok {
-                    (u, q) = (uu, qq);
-                    done = true;
-                    break;
-                }
-            }
-            if done {
-                s.p = u.fixed_rows::<3>(0).into_owned();
-                s.m = u.fixed_rows::<3>(3).into_owned();
-                s.q = q;
-            } else {
-                self.give_up(GaveUp::Kirchhoff);
-                s.p = Vector3::from_element(f64::NAN);
-                s.m = s.p;
-            }
-            return;
-        }
-        let (m1, q1) = self.vessel.body.free.flow(&s.m, &s.q, h, order);
-        s.p = q1.transpose() * (s.q * s.p);
-        s.m = m1;
-        s.q = q1;
     }
 }
 

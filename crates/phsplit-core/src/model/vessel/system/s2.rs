@@ -22,6 +22,9 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 /// Most fixed-point passes over the forcing of flow S2 in one sub-step.
 const FORCED_MAX_ITERATIONS: usize = 200;
 
+mod coupled;
+pub(super) use coupled::augmented;
+
 /// The stage system of at most three Gauss stages of one 10-dimensional block system.
 type Stages = SMatrix<f64, 30, 30>;
 type StageVector = SVector<f64, 30>;
@@ -131,14 +134,7 @@ impl VesselSystem<'_> {
             }
         });
         let stateful = self.forced_stateful;
-        let (mut last_change, mut last_parts) = (f64::INFINITY, f64::INFINITY);
-        // Aitken's relaxation of the fixed point (B. M. Irons, R. C. Tuck, Int. J. Numer. Meth.
-        // Eng. 1 (1969) 275–277; in the form of U. Küttler, W. A. Wall, Comput. Mech. 43 (2008)
-        // 61–72, eq. 44): x ← x + ω r with r = G(x) − x and ω ← −ω r_oldᵀ(r − r_old)/|r − r_old|².
-        // A dissipative forcing (quadratic damping at long steps) makes the plain iteration
-        // oscillate with a rate that can pass 1; the relaxation damps that, and leaves a
-        // quickly converging iteration as it was (ω ≈ 1).
-        let mut omega = 1.0;
+        let mut fp = FixedPoint::new();
         let mut prev_r: Option<[[SVector<f64, 10>; 3]; 2]> = None;
         for it in 0..FORCED_MAX_ITERATIONS {
             for i in 0..s {
@@ -147,7 +143,6 @@ impl VesselSystem<'_> {
                     g[i].add(&self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true)));
                 }
             }
-            let (mut change, mut parts): (f64, f64) = (0.0, 0.0);
             let mut r = [[SVector::<f64, 10>::zeros(); 3]; 2];
             for k in 0..2 {
                 let gt: [SVector<f64, 10>; 3] = std::array::from_fn(|j| {
@@ -174,58 +169,30 @@ impl VesselSystem<'_> {
                 }
             }
             if let Some(pr) = &prev_r {
-                let (mut num, mut den) = (0.0, 0.0);
                 for k in 0..2 {
                     for i in 0..s {
-                        let d = r[k][i] - pr[k][i];
-                        num += pr[k][i].dot(&d);
-                        den += d.norm_squared();
+                        fp.compare(r[k][i].as_slice(), pr[k][i].as_slice());
                     }
                 }
-                if den > 0.0 && num.is_finite() {
-                    omega = (-omega * num / den).clamp(0.05, 2.0);
-                }
             }
-            // Convergence is judged on the residual `G(x) − x` itself, not on the relaxed step
-            // (Aitken's steps do not shrink steadily); a NaN anywhere makes it NaN.
+            let omega = fp.relax();
             for k in 0..2 {
                 for i in 0..s {
                     let yi = ys[k][i] + r[k][i] * omega;
-                    let (res, part) = relative_change(r[k][i].as_slice(), yi.as_slice(), 9);
-                    change = if res.is_nan() || change.is_nan() {
-                        f64::NAN
-                    } else {
-                        change.max(res)
-                    };
-                    parts = parts.max(part);
+                    fp.measure(r[k][i].as_slice(), yi.as_slice(), 9);
                     ys[k][i] = yi;
                     stage_z[i][k] = unpack(&yi, k);
                 }
             }
             prev_r = Some(r);
-            if !change.is_finite() {
-                // The fixed point diverged (or a stage overflowed).
-                self.give_up(GaveUp::Forcing);
-                return nan;
+            match fp.verdict(it, stateful) {
+                Verdict::Continue => {}
+                Verdict::Converged => break,
+                Verdict::Failed => {
+                    self.give_up(GaveUp::Forcing);
+                    return nan;
+                }
             }
-            // Converged: the stages no longer move, every part of them (a forcing independent of
-            // the state converges at the second pass), or, at round-off of the whole, their parts
-            // stopped improving.
-            if it > 0
-                && (parts <= 4.0 * f64::EPSILON
-                    || (change < 1e-12 && change >= last_change && parts >= last_parts))
-            {
-                break;
-            }
-            if it + 1 == FORCED_MAX_ITERATIONS && change > 1e-10 {
-                self.give_up(GaveUp::Forcing);
-                return nan;
-            }
-            // Without a state-dependent forcing the first pass is the solution.
-            if !stateful {
-                break;
-            }
-            (last_change, last_parts) = (change, parts);
         }
         for i in 0..s {
             g[i] = fixed[i];
@@ -327,277 +294,95 @@ impl VesselSystem<'_> {
     }
 }
 
-/// The state of the coupled system: `z̄ = (u_t, v_t, w_t, u_r, v_r, w_r, 1)`.
-type Full = SMatrix<f64, 19, 19>;
-type FullVector = SVector<f64, 19>;
-
-/// Flow S2 as one augmented matrix `Ā` on `z̄ = (u_t, v_t, w_t, u_r, v_r, w_r, 1)`: the two
-/// block systems on the diagonal and, when they are coupled, what each takes from the other's
-/// momentum.
-pub(super) fn augmented(b: &S2Builder) -> Full {
-    let mut a = Full::zeros();
-    for k in 0..2 {
-        let o = 9 * k;
-        let blk = b.sys[k].augmented();
-        a.fixed_view_mut::<9, 9>(o, o)
-            .copy_from(&blk.fixed_view::<9, 9>(0, 0));
-        a.fixed_view_mut::<9, 1>(o, 18)
-            .copy_from(&blk.fixed_view::<9, 1>(0, 9));
-        if let Some(c) = &b.cross {
-            let l = 9 * (1 - k);
-            a.fixed_view_mut::<3, 3>(o, l).copy_from(&c[k][0]);
-            a.fixed_view_mut::<3, 3>(o + 3, l).copy_from(&c[k][1]);
-            a.fixed_view_mut::<3, 3>(o, l + 3).copy_from(&c[k][2]);
-        }
-    }
-    a
+/// The fixed point of the forcing in a Gauss collocation of flow S2 (the block systems' and the
+/// coupled system's): Aitken's relaxation and the stopping rule.
+///
+/// Aitken's relaxation (B. M. Irons, R. C. Tuck, Int. J. Numer. Meth. Eng. 1 (1969) 275–277; in
+/// the form of U. Küttler, W. A. Wall, Comput. Mech. 43 (2008) 61–72, eq. 44): `x ← x + ω r`
+/// with `r = G(x) − x` and `ω ← −ω r_oldᵀ(r − r_old)/|r − r_old|²`, clamped to `[0.05, 2]`. A
+/// dissipative forcing (quadratic damping at long steps) makes the plain iteration oscillate with
+/// a rate that can pass 1; the relaxation damps that, and leaves a quickly converging iteration
+/// as it was (`ω ≈ 1`). Convergence is judged on the residual `G(x) − x` itself, not on the
+/// relaxed step (Aitken's steps do not shrink steadily), whole and part by part
+/// ([`relative_change`]); a NaN anywhere makes it NaN.
+struct FixedPoint {
+    omega: f64,
+    /// `r_oldᵀ(r − r_old)` and `|r − r_old|²` of this pass.
+    num: f64,
+    den: f64,
+    /// This pass's residual, whole and by parts, and the previous pass's.
+    change: f64,
+    parts: f64,
+    last_change: f64,
+    last_parts: f64,
 }
 
-fn pack_full(z: &[Z3; 2], one: f64) -> FullVector {
-    let mut y = FullVector::zeros();
-    for k in 0..2 {
-        for i in 0..3 {
-            y.fixed_rows_mut::<3>(9 * k + 3 * i).copy_from(&z[k][i]);
-        }
-    }
-    y[18] = one;
-    y
+/// What a pass of the fixed point concluded.
+enum Verdict {
+    Continue,
+    Converged,
+    /// Diverged, overflowed, or still above 1e-10 after [`FORCED_MAX_ITERATIONS`] passes.
+    Failed,
 }
 
-fn unpack_full(y: &FullVector) -> [Z3; 2] {
-    std::array::from_fn(|k| std::array::from_fn(|i| y.fixed_rows::<3>(9 * k + 3 * i).into_owned()))
-}
-
-impl VesselSystem<'_> {
-    /// The balancing of the coupled system: each block system's as in [`balance`], with the
-    /// diagonal of `M` as the momentum scale.
-    fn balance_full(&self, b: &S2Builder) -> FullVector {
-        let md = self.vessel.body.mass_matrix.diagonal();
-        let mut out = FullVector::from_element(1.0);
-        for k in 0..2 {
-            let minv = Vector3::from_fn(|i, _| 1.0 / md[3 * k + i]);
-            let sk = balance(&b.sys[k], &minv);
-            out.fixed_rows_mut::<9>(9 * k)
-                .copy_from(&sk.fixed_rows::<9>(0));
-        }
-        out
-    }
-
-    /// The quadratic form of an account's power `Σ_k ν_kᵀ f_k` on `z̄`, symmetrised, with
-    /// `ν = M⁻¹u` through the full `M⁻¹`.
-    fn power_form_full(&self, rows: &[Rows; 2]) -> Full {
-        let mi = &self.vessel.body.minv_blocks;
-        // ν = E z̄.
-        let mut e = SMatrix::<f64, 6, 19>::zeros();
-        for j in 0..2 {
-            for l in 0..2 {
-                e.fixed_view_mut::<3, 3>(3 * j, 9 * l).copy_from(&mi[j][l]);
-            }
-        }
-        let mut r = SMatrix::<f64, 6, 19>::zeros();
-        for (k, f) in rows.iter().enumerate() {
-            let mut rk =
-                f.fnu[0] * e.fixed_view::<3, 19>(0, 0) + f.fnu[1] * e.fixed_view::<3, 19>(3, 0);
-            let mut fv = rk.fixed_view_mut::<3, 3>(0, 9 * k + 3);
-            fv += f.fv;
-            let mut fw = rk.fixed_view_mut::<3, 3>(0, 9 * k + 6);
-            fw += f.fw;
-            let mut c = rk.fixed_view_mut::<3, 1>(0, 18);
-            c += f.c;
-            r.fixed_view_mut::<3, 19>(3 * k, 0).copy_from(&rk);
-        }
-        let m = e.transpose() * r * 0.5;
-        m + m.transpose()
-    }
-
-    /// Flow S2 where translation and rotation are coupled (a general mass matrix, or a force
-    /// that couples them; docs/model.md §5.14): one 18-dimensional affine system, by its exact
-    /// flow with the ledger by the Van Loan Gramian (one 38×38 exponential), or, with
-    /// [`LinearFlow::Gauss`] or a forcing part, by Gauss collocation with `s` stages (the
-    /// forcing iterated to a fixed point as in the block systems' collocation, with the same
-    /// Aitken relaxation and stopping rule) and the ledger by the Gauss quadrature of the
-    /// power, exact for the quadratic storage.
-    pub(super) fn coupled_s2(
-        &self,
-        fr: &Frozen,
-        b: &S2Builder,
-        z0: &[Z3; 2],
-        h: f64,
-        t: f64,
-        s: usize,
-    ) -> ([Z3; 2], Work) {
-        let scale = self.balance_full(b);
-        let inv = scale.map(|v| 1.0 / v);
-        let abar = augmented(b);
-        let a = Full::from_fn(|i, j| abar[(i, j)] * scale[j] * inv[i]);
-        let zb0 = pack_full(z0, 1.0).component_mul(&inv);
-        if !self.forced && self.linear == LinearFlow::Exact {
-            let mut work = Work::default();
-            let zb1 = match &b.booked {
-                Some(booked) => {
-                    let (f, gram) = affine::flow_and_gramian::<19, 38>(&a, &zb0, h);
-                    for acc in 0..self.accounts.len() {
-                        let m = self.power_form_full(&booked[acc]);
-                        let mb = Full::from_fn(|i, j| m[(i, j)] * scale[i] * scale[j]);
-                        work.0[acc] += self.sign(acc) * affine::trace_product(&mb, &gram);
-                    }
-                    f * zb0
-                }
-                None => affine::flow(&a, h) * zb0,
-            };
-            let z1 = unpack_full(&zb1.component_mul(&scale));
-            return (z1, work);
-        }
-        match s {
-            1 => self.coupled_collocation::<19>(fr, b, z0, &a, &scale, h, t, 1),
-            2 => self.coupled_collocation::<38>(fr, b, z0, &a, &scale, h, t, 2),
-            _ => self.coupled_collocation::<57>(fr, b, z0, &a, &scale, h, t, 3),
+impl FixedPoint {
+    fn new() -> Self {
+        Self {
+            omega: 1.0,
+            num: 0.0,
+            den: 0.0,
+            change: 0.0,
+            parts: 0.0,
+            last_change: f64::INFINITY,
+            last_parts: f64::INFINITY,
         }
     }
-
-    /// The Gauss collocation of [`Self::coupled_s2`] with `s` stages, `NS = 19 s`, on the
-    /// balanced system `a` (scaling `scale`).
-    #[allow(clippy::too_many_arguments)]
-    fn coupled_collocation<const NS: usize>(
-        &self,
-        fr: &Frozen,
-        b: &S2Builder,
-        z0: &[Z3; 2],
-        a: &Full,
-        scale: &FullVector,
-        h: f64,
-        t: f64,
-        s: usize,
-    ) -> ([Z3; 2], Work)
-    where
-        nalgebra::Const<NS>: nalgebra::DimMin<nalgebra::Const<NS>, Output = nalgebra::Const<NS>>,
-    {
-        let nan = ([[Vector3::from_element(f64::NAN); 3]; 2], Work::default());
-        let inv = scale.map(|v| 1.0 / v);
-        let zb0 = pack_full(z0, 1.0).component_mul(&inv);
-        let (ta, bw) = gauss::tableau(s);
-        let nodes: [f64; 3] = std::array::from_fn(|i| ta[i].iter().sum());
-        let mut m = SMatrix::<f64, NS, NS>::identity();
-        for i in 0..s {
-            for j in 0..s {
-                let mut v = m.fixed_view_mut::<19, 19>(19 * i, 19 * j);
-                v -= *a * (h * ta[i][j]);
-            }
+    /// One stage's residual `r` against the previous pass's `r_old`, for Aitken's factor.
+    fn compare(&mut self, r: &[f64], r_old: &[f64]) {
+        for (a, b) in r.iter().zip(r_old) {
+            let d = a - b;
+            self.num += b * d;
+            self.den += d * d;
         }
-        let lu = m.lu();
-        let forcing_at = |i: usize, z: &[Z3; 2], uses: Option<bool>| {
-            self.forcing_of(fr, t + nodes[i] * h, z, uses)
+    }
+    /// Aitken's factor for this pass (1 on the first), from what [`Self::compare`] gathered.
+    fn relax(&mut self) -> f64 {
+        if self.den > 0.0 && self.num.is_finite() {
+            self.omega = (-self.omega * self.num / self.den).clamp(0.05, 2.0);
+        }
+        (self.num, self.den, self.change, self.parts) = (0.0, 0.0, 0.0, 0.0);
+        self.omega
+    }
+    /// One stage's residual `r` at its relaxed iterate `y` (its first `n` entries the states).
+    fn measure(&mut self, r: &[f64], y: &[f64], n: usize) {
+        let (res, part) = relative_change(r, y, n);
+        self.change = if res.is_nan() || self.change.is_nan() {
+            f64::NAN
+        } else {
+            self.change.max(res)
         };
-        let mut stage_z = [*z0; 3];
-        let mut ys: [FullVector; 3] =
-            std::array::from_fn(|i| if i < s { zb0 } else { FullVector::zeros() });
-        let fixed: [Forcing; 3] = std::array::from_fn(|i| {
-            if i < s && self.forced {
-                forcing_at(i, z0, Some(false))
-            } else {
-                Forcing::new()
-            }
-        });
-        let stateful = self.forced_stateful;
-        let total = |i: usize, z: &[Z3; 2]| {
-            let mut g = fixed[i];
-            if stateful {
-                g.add(&forcing_at(i, z, Some(true)));
-            }
-            g
-        };
-        let (mut omega, mut last_change, mut last_parts) = (1.0, f64::INFINITY, f64::INFINITY);
-        let mut prev_r: Option<[FullVector; 3]> = None;
-        let mut g = [Forcing::new(); 3];
-        for it in 0..FORCED_MAX_ITERATIONS {
-            for i in 0..s {
-                g[i] = total(i, &stage_z[i]);
-            }
-            let gt: [FullVector; 3] =
-                std::array::from_fn(|j| pack_full(&g[j].g, 0.0).component_mul(&inv));
-            let mut rhs = SVector::<f64, NS>::zeros();
-            for i in 0..s {
-                let mut r = zb0;
-                for j in 0..s {
-                    r += gt[j] * (h * ta[i][j]);
-                }
-                rhs.fixed_rows_mut::<19>(19 * i).copy_from(&r);
-            }
-            let Some(y) = lu.solve(&rhs) else {
-                self.give_up(GaveUp::Singular);
-                return nan;
-            };
-            let r: [FullVector; 3] = std::array::from_fn(|i| {
-                if i < s {
-                    y.fixed_rows::<19>(19 * i) - ys[i]
-                } else {
-                    FullVector::zeros()
-                }
-            });
-            if let Some(pr) = &prev_r {
-                let (mut num, mut den) = (0.0, 0.0);
-                for i in 0..s {
-                    let d = r[i] - pr[i];
-                    num += pr[i].dot(&d);
-                    den += d.norm_squared();
-                }
-                if den > 0.0 && num.is_finite() {
-                    omega = (-omega * num / den).clamp(0.05, 2.0);
-                }
-            }
-            let (mut change, mut parts): (f64, f64) = (0.0, 0.0);
-            for i in 0..s {
-                let yi = ys[i] + r[i] * omega;
-                let (res, part) = relative_change(r[i].as_slice(), yi.as_slice(), 18);
-                change = if res.is_nan() || change.is_nan() {
-                    f64::NAN
-                } else {
-                    change.max(res)
-                };
-                parts = parts.max(part);
-                ys[i] = yi;
-                stage_z[i] = unpack_full(&yi.component_mul(scale));
-            }
-            prev_r = Some(r);
-            if !change.is_finite() {
-                // The fixed point diverged (or a stage overflowed).
-                self.give_up(GaveUp::Forcing);
-                return nan;
-            }
-            // As in the block systems' collocation.
-            if !stateful
-                || (it > 0
-                    && (parts <= 4.0 * f64::EPSILON
-                        || (change < 1e-12 && change >= last_change && parts >= last_parts)))
-            {
-                break;
-            }
-            if it + 1 == FORCED_MAX_ITERATIONS && change > 1e-10 {
-                self.give_up(GaveUp::Forcing);
-                return nan;
-            }
-            (last_change, last_parts) = (change, parts);
+        self.parts = self.parts.max(part);
+    }
+    /// After pass `it`: converged when every part of the stages has stopped moving (a forcing
+    /// independent of the state, `stateful` false, at the first pass), or when the whole is at
+    /// round-off (below 1e-12) and neither measure improves any more.
+    fn verdict(&mut self, it: usize, stateful: bool) -> Verdict {
+        let (change, parts) = (self.change, self.parts);
+        if !change.is_finite() {
+            return Verdict::Failed;
         }
-        for i in 0..s {
-            g[i] = total(i, &stage_z[i]);
+        if !stateful
+            || (it > 0
+                && (parts <= 4.0 * f64::EPSILON
+                    || (change < 1e-12 && change >= self.last_change && parts >= self.last_parts)))
+        {
+            return Verdict::Converged;
         }
-        let mut y1 = zb0;
-        for i in 0..s {
-            y1 += (*a * ys[i] + pack_full(&g[i].g, 0.0).component_mul(&inv)) * (h * bw[i]);
+        if it + 1 == FORCED_MAX_ITERATIONS && change > 1e-10 {
+            return Verdict::Failed;
         }
-        let z1 = unpack_full(&y1.component_mul(scale));
-        let mut work = Work::default();
-        if let Some(booked) = &b.booked {
-            for i in 0..s {
-                let mut p = self.power_at(booked, &stage_z[i]);
-                p += self.forcing_power(&g[i], &stage_z[i]);
-                work += p.scaled(h * bw[i]);
-            }
-        }
-        if !z1.iter().flatten().all(|v| v.iter().all(|x| x.is_finite())) {
-            return nan;
-        }
-        (z1, work)
+        (self.last_change, self.last_parts) = (change, parts);
+        Verdict::Continue
     }
 }
 
