@@ -7,9 +7,11 @@ use phsplit_core::solve::{run, Model};
 #[test]
 fn running_maxima_cover_every_step_whatever_is_saved() {
     let v = Vessel::paper();
-    for method in ["sp2", "rk4"] {
+    for (method, project) in [("sp2", true), ("sp2", false), ("rk4", true)] {
         let every = |save_every: usize| {
-            let sys = VesselSystem::new(&v, Some(10.0)).with_extrema(true);
+            let sys = VesselSystem::new(&v, Some(10.0))
+                .with_extrema(true)
+                .with_projection(project);
             let s = Settings {
                 t_span: (0.0, 100.0),
                 h: 0.25,
@@ -57,5 +59,34 @@ fn running_maxima_cover_every_step_whatever_is_saved() {
             all.probe_max[0]
         );
         assert!(all.probe_max_t[0] >= 10.0);
+    }
+}
+
+/// Without the projection (which needs the state at every step boundary), a composition merges
+/// its last and first sub-steps across unsaved boundaries, and the state at those boundaries
+/// never exists; a run that keeps running maxima must not merge: saving every 50th step then
+/// gives bitwise the states and maxima of saving every step.
+#[test]
+fn running_maxima_do_not_merge_sub_steps_away() {
+    let v = Vessel::paper();
+    for method in ["sp2", "sp4"] {
+        let every = |save_every: usize| {
+            let sys = VesselSystem::new(&v, Some(0.0))
+                .with_extrema(true)
+                .with_projection(false);
+            let s = Settings {
+                t_span: (0.0, 100.0),
+                h: 0.25,
+                method: method.parse().unwrap(),
+                control_start: Some(0.0),
+                save_every,
+                ..Settings::default()
+            };
+            run(&sys, &s.method, v.initial_state(), &s.options().unwrap()).unwrap()
+        };
+        let (all, some) = (every(1), every(50));
+        assert_eq!(some.states.last(), all.states.last(), "{method}");
+        assert_eq!(some.states[1], all.states[50], "{method}");
+        assert_eq!(some.probe_max, all.probe_max, "{method}");
     }
 }

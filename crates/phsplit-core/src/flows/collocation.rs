@@ -213,26 +213,26 @@ impl Blocks {
 /// of `T⁻¹` (`T` the matrix of eigenvectors); `pair` when `λ` stands for itself and its
 /// conjugate.
 #[derive(Debug, Clone, Copy)]
-struct Mode {
-    lam: Complex<f64>,
-    t: [Complex<f64>; 3],
-    tau: [Complex<f64>; 3],
-    pair: bool,
+pub(crate) struct Mode {
+    pub(crate) lam: Complex<f64>,
+    pub(crate) t: [Complex<f64>; 3],
+    pub(crate) tau: [Complex<f64>; 3],
+    pub(crate) pair: bool,
 }
 
 /// The `s`-stage Gauss tableau with what the transformed stage solve needs, computed once.
 #[derive(Debug)]
-struct Transformed {
-    a: [[f64; 3]; 3],
+pub(crate) struct Transformed {
+    pub(crate) a: [[f64; 3]; 3],
     /// `𝒜1, 𝒜²1, 𝒜³1` (the first is the nodes).
-    pow1: [[f64; 3]; 3],
+    pub(crate) pow1: [[f64; 3]; 3],
     /// `bᵀ𝒜⁻¹`: the update is `z1 = z0 + Σ d_i (Z_i − z0)`.
-    d: [f64; 3],
-    modes: [Mode; 2],
-    n_modes: usize,
+    pub(crate) d: [f64; 3],
+    pub(crate) modes: [Mode; 2],
+    pub(crate) n_modes: usize,
 }
 
-fn transformed(s: usize) -> &'static Transformed {
+pub(crate) fn transformed(s: usize) -> &'static Transformed {
     static CACHE: [OnceLock<Transformed>; 3] = [const { OnceLock::new() }; 3];
     CACHE[s - 1].get_or_init(|| build_transformed(s))
 }

@@ -4,3 +4,4 @@ pub mod affine;
 pub mod collocation;
 pub mod kirchhoff;
 pub mod rigid_body;
+pub mod stage_solve;

@@ -49,7 +49,6 @@ pub fn run_splitting_watched<M: SplitModel>(
     let last = subs.len() - 1;
     let mut rec = Recorder::new(model, opts.t0, y0, opts);
     let mut y = y0;
-    // A last sub-step deferred into the next step: (flow, length, its step's start time).
     // A last sub-step deferred into the next step: (flow, length, its step's start time, the
     // time it starts at).
     let mut pending: Option<(Flow, f64, f64, f64)> = None;
@@ -80,6 +79,7 @@ pub fn run_splitting_watched<M: SplitModel>(
                 && !saves_after(n, opts)
                 && model.same_field(t, t1)
                 && !model.projects()
+                && model.probe_names().is_empty()
             {
                 pending = Some((flow, len, t, start));
                 continue;

@@ -97,38 +97,39 @@ const ACCOUNTS: [Account; 2] = [
     },
 ];
 
-/// `∫_{x1}^{x2} x^k (a + b x)^n dx`, expanded binomially (exact polynomial integral).
-fn piece(a: f64, b: f64, x1: f64, x2: f64, k: i32, n: i32) -> f64 {
-    let mut sum = 0.0;
-    let mut binom = 1.0;
-    for j in 0..=n {
-        let e = k + j + 1;
-        sum += binom * a.powi(n - j) * b.powi(j) * (x2.powi(e) - x1.powi(e)) / e as f64;
-        binom = binom * (n - j) as f64 / (j + 1) as f64;
-    }
-    sum
+/// On one piece `[x1, x2]` where `s = a + b x` keeps its sign: `(∫s², ∫x s², ∫s, ∫x² s)`,
+/// expanded in the moments `m_e = (x2^e − x1^e)/e` (exact polynomial integrals, no division by
+/// `b`: no cancellation as `b → 0`).
+fn piece(a: f64, b: f64, x1: f64, x2: f64) -> [f64; 4] {
+    let (p1, q1) = (x1, x2);
+    let (p2, q2) = (p1 * x1, q1 * x2);
+    let (p3, q3) = (p2 * x1, q2 * x2);
+    let (p4, q4) = (p3 * x1, q3 * x2);
+    let m = [q1 - p1, (q2 - p2) / 2.0, (q3 - p3) / 3.0, (q4 - p4) / 4.0];
+    let (aa, ab, bb) = (a * a, 2.0 * a * b, b * b);
+    [
+        aa * m[0] + ab * m[1] + bb * m[2],
+        aa * m[1] + ab * m[2] + bb * m[3],
+        a * m[0] + b * m[1],
+        a * m[2] + b * m[3],
+    ]
 }
 
 /// The strip integrals of `s = a + b x` over `[x1, x2]`:
 /// `(∫|s|s, ∫x|s|s, ∫|s|, ∫x²|s|)`, exact: `|s|s = ±s²` and `|s| = ±s` on each side of the
 /// zero `x0 = −a/b`, so the interval is split there.
 pub fn strip_integrals(a: f64, b: f64, x1: f64, x2: f64) -> [f64; 4] {
-    let mut cuts = vec![x1];
-    if b != 0.0 {
-        let x0 = -a / b;
-        if x0 > x1 && x0 < x2 {
-            cuts.push(x0);
-        }
-    }
-    cuts.push(x2);
+    let x0 = if b != 0.0 { -a / b } else { f64::NAN };
+    let split = x0 > x1 && x0 < x2;
+    let cuts = if split { [x1, x0, x2] } else { [x1, x2, x2] };
     let mut out = [0.0; 4];
-    for w in cuts.windows(2) {
+    for w in cuts.windows(2).take(if split { 2 } else { 1 }) {
         let mid = 0.5 * (w[0] + w[1]);
         let sign = (a + b * mid).signum();
-        out[0] += sign * piece(a, b, w[0], w[1], 0, 2);
-        out[1] += sign * piece(a, b, w[0], w[1], 1, 2);
-        out[2] += sign * piece(a, b, w[0], w[1], 0, 1);
-        out[3] += sign * piece(a, b, w[0], w[1], 2, 1);
+        let p = piece(a, b, w[0], w[1]);
+        for (o, v) in out.iter_mut().zip(p) {
+            *o += sign * v;
+        }
     }
     out
 }

@@ -11,8 +11,9 @@ use super::super::{GaveUp, LinearFlow, VesselSystem};
 use super::{balance, FixedPoint, Verdict, FORCED_MAX_ITERATIONS};
 use crate::flows::affine;
 use crate::flows::collocation::{self as gauss, Z3};
+use crate::flows::stage_solve::{Parts, StageSolver, Structure};
 use crate::solve::Work;
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// The state of the coupled system: `z̄ = (u_t, v_t, w_t, u_r, v_r, w_r, 1)`.
 type Full = SMatrix<f64, 19, 19>;
@@ -53,6 +54,82 @@ fn pack_full(z: &[Z3; 2], one: f64) -> FullVector {
 
 fn unpack_full(y: &FullVector) -> [Z3; 2] {
     std::array::from_fn(|k| std::array::from_fn(|i| y.fixed_rows::<3>(9 * k + 3 * i).into_owned()))
+}
+
+/// A state `(u, v, w)` in blocks of six: `u = (u_t, u_r)`, `v = (v_t, v_r)`, `w = (w_t, w_r)`.
+type Six = Parts<f64, 6>;
+
+/// The balancing `scale` (on `z̄`'s order) as blocks of six, and its reciprocal.
+fn six_scales(scale: &FullVector) -> (Six, Six) {
+    let sc: Six = std::array::from_fn(|c| {
+        SVector::<f64, 6>::from_fn(|j, _| scale[9 * (j / 3) + 3 * c + j % 3])
+    });
+    (sc, sc.map(|v| v.map(|x| 1.0 / x)))
+}
+
+/// The coupled system in blocks of six, balanced (`sc`, its reciprocal `inv`): its linear part
+/// and its constants `(c_u, 0, c_w)`. The rows of `v` read only the momenta and those of `w`
+/// only their own system's `v` ([`augmented`]), which is [`Structure`]'s form.
+fn six_blocks(b: &S2Builder, sc: &Six, inv: &Six) -> (Structure<6>, Six) {
+    let m6 = |diag: [Matrix3<f64>; 2], cross: Option<[Matrix3<f64>; 2]>, r: usize, c: usize| {
+        let mut m = SMatrix::<f64, 6, 6>::zeros();
+        for k in 0..2 {
+            m.fixed_view_mut::<3, 3>(3 * k, 3 * k).copy_from(&diag[k]);
+            if let Some(x) = cross {
+                m.fixed_view_mut::<3, 3>(3 * k, 3 * (1 - k))
+                    .copy_from(&x[k]);
+            }
+        }
+        SMatrix::<f64, 6, 6>::from_fn(|i, j| m[(i, j)] * sc[c][j] * inv[r][i])
+    };
+    let cross = |n: usize| b.cross.map(|x| [x[0][n], x[1][n]]);
+    let (s0, s1) = (&b.sys[0], &b.sys[1]);
+    let st = Structure {
+        auu: m6([s0.auu, s1.auu], cross(0), 0, 0),
+        auv: m6([s0.auv, s1.auv], cross(2), 0, 1),
+        auw: m6([s0.auw, s1.auw], None, 0, 2),
+        avu: m6([s0.avu, s1.avu], cross(1), 1, 0),
+        awv: m6([s0.awv, s1.awv], None, 2, 1),
+    };
+    let c = to_six(&[
+        [s0.cu, Vector3::zeros(), s0.cw],
+        [s1.cu, Vector3::zeros(), s1.cw],
+    ]);
+    (st, mul6(&c, inv))
+}
+
+/// The block systems' `[Z3; 2]` as blocks of six.
+fn to_six(z: &[Z3; 2]) -> Six {
+    std::array::from_fn(|c| {
+        let mut v = SVector::<f64, 6>::zeros();
+        v.fixed_rows_mut::<3>(0).copy_from(&z[0][c]);
+        v.fixed_rows_mut::<3>(3).copy_from(&z[1][c]);
+        v
+    })
+}
+
+/// The inverse of [`to_six`].
+fn from_six(p: &Six) -> [Z3; 2] {
+    std::array::from_fn(|k| std::array::from_fn(|c| p[c].fixed_rows::<3>(3 * k).into_owned()))
+}
+
+/// Entry by entry `a b`.
+fn mul6(a: &Six, b: &Six) -> Six {
+    std::array::from_fn(|c| a[c].component_mul(&b[c]))
+}
+
+/// `a + b t`, block by block.
+fn axpy(a: &Six, b: &Six, t: f64) -> Six {
+    std::array::from_fn(|c| a[c] + b[c] * t)
+}
+
+/// The 18 states of a [`Six`] in one vector (for the fixed point's measures, in 3-vectors).
+fn flat(p: &Six) -> SVector<f64, 18> {
+    let mut y = SVector::<f64, 18>::zeros();
+    for c in 0..3 {
+        y.fixed_rows_mut::<6>(6 * c).copy_from(&p[c]);
+    }
+    y
 }
 
 impl VesselSystem<'_> {
@@ -114,111 +191,125 @@ impl VesselSystem<'_> {
         s: usize,
     ) -> ([Z3; 2], Work) {
         let scale = self.balance_full(b);
+        if !self.forced && self.linear == LinearFlow::Exact {
+            return self.coupled_exact(b, z0, &scale, h);
+        }
+        self.coupled_collocation(fr, b, z0, &scale, h, t, s)
+    }
+
+    /// The exact flow of [`Self::coupled_s2`], balanced by `scale`, with each account's energy
+    /// from the Van Loan Gramian. Kept out of line: its 38×38 temporaries would otherwise make
+    /// every collocated sub-step pay for a stack frame of a few hundred kilobytes.
+    #[inline(never)]
+    fn coupled_exact(
+        &self,
+        b: &S2Builder,
+        z0: &[Z3; 2],
+        scale: &FullVector,
+        h: f64,
+    ) -> ([Z3; 2], Work) {
         let inv = scale.map(|v| 1.0 / v);
         let abar = augmented(b);
         let a = Full::from_fn(|i, j| abar[(i, j)] * scale[j] * inv[i]);
         let zb0 = pack_full(z0, 1.0).component_mul(&inv);
-        if !self.forced && self.linear == LinearFlow::Exact {
-            let mut work = Work::default();
-            let zb1 = match &b.booked {
-                Some(booked) => {
-                    let (f, gram) = affine::flow_and_gramian::<19, 38>(&a, &zb0, h);
-                    for acc in 0..self.accounts.len() {
-                        let m = self.power_form_full(&booked[acc]);
-                        let mb = Full::from_fn(|i, j| m[(i, j)] * scale[i] * scale[j]);
-                        work.0[acc] += self.sign(acc) * affine::trace_product(&mb, &gram);
-                    }
-                    f * zb0
+        let mut work = Work::default();
+        let zb1 = match &b.booked {
+            Some(booked) => {
+                let (f, gram) = affine::flow_and_gramian::<19, 38>(&a, &zb0, h);
+                for acc in 0..self.accounts.len() {
+                    let m = self.power_form_full(&booked[acc]);
+                    let mb = Full::from_fn(|i, j| m[(i, j)] * scale[i] * scale[j]);
+                    work.0[acc] += self.sign(acc) * affine::trace_product(&mb, &gram);
                 }
-                None => affine::flow(&a, h) * zb0,
-            };
-            let z1 = unpack_full(&zb1.component_mul(&scale));
-            return (z1, work);
-        }
-        match s {
-            1 => self.coupled_collocation::<19>(fr, b, z0, &a, &scale, h, t, 1),
-            2 => self.coupled_collocation::<38>(fr, b, z0, &a, &scale, h, t, 2),
-            _ => self.coupled_collocation::<57>(fr, b, z0, &a, &scale, h, t, 3),
-        }
+                f * zb0
+            }
+            None => affine::flow(&a, h) * zb0,
+        };
+        (unpack_full(&zb1.component_mul(scale)), work)
     }
 
-    /// The Gauss collocation of [`Self::coupled_s2`] with `s` stages, `NS = 19 s`, on the
-    /// balanced system `a` (scaling `scale`).
+    /// The Gauss collocation of [`Self::coupled_s2`] with `s` stages, balanced by `scale`. The
+    /// stage equations keep the block structure of flow S2 with blocks of six ([`six_blocks`])
+    /// and are solved for the stage increments by the transformed, reduced `6 × 6` systems of
+    /// [`StageSolver`], factorised once per sub-step and solved once per pass of the forcing's
+    /// fixed point.
     #[allow(clippy::too_many_arguments)]
-    fn coupled_collocation<const NS: usize>(
+    fn coupled_collocation(
         &self,
         fr: &Frozen,
         b: &S2Builder,
         z0: &[Z3; 2],
-        a: &Full,
         scale: &FullVector,
         h: f64,
         t: f64,
         s: usize,
-    ) -> ([Z3; 2], Work)
-    where
-        nalgebra::Const<NS>: nalgebra::DimMin<nalgebra::Const<NS>, Output = nalgebra::Const<NS>>,
-    {
+    ) -> ([Z3; 2], Work) {
         let nan = ([[Vector3::from_element(f64::NAN); 3]; 2], Work::default());
-        let inv = scale.map(|v| 1.0 / v);
-        let zb0 = pack_full(z0, 1.0).component_mul(&inv);
+        let (sc, inv) = six_scales(scale);
+        let (st, cst) = six_blocks(b, &sc, &inv);
+        let field = |y: &Six| {
+            let f = st.apply(y);
+            [f[0] + cst[0], f[1], f[2] + cst[2]]
+        };
+        let zb0 = mul6(&to_six(z0), &inv);
         let (ta, bw) = gauss::tableau(s);
         let nodes: [f64; 3] = std::array::from_fn(|i| ta[i].iter().sum());
-        let mut m = SMatrix::<f64, NS, NS>::identity();
-        for i in 0..s {
-            for j in 0..s {
-                let mut v = m.fixed_view_mut::<19, 19>(19 * i, 19 * j);
-                v -= *a * (h * ta[i][j]);
-            }
-        }
-        let lu = m.lu();
+        let solver = StageSolver::new(&st, h, s);
+        // R_i = h c_i f(z0) + h Σ_j a_ij g_j.
+        let f0 = field(&zb0);
+        let forced = self.forced;
+        let stateful = self.forced_stateful;
         let forcing_at = |i: usize, z: &[Z3; 2], uses: Option<bool>| {
             self.forcing_of(fr, t + nodes[i] * h, z, uses)
         };
-        let mut stage_z = [*z0; 3];
-        let mut ys: [FullVector; 3] =
-            std::array::from_fn(|i| if i < s { zb0 } else { FullVector::zeros() });
+        // The parts of the forcing that depend on time only, once per stage; the rest per pass.
         let fixed: [Forcing; 3] = std::array::from_fn(|i| {
-            if i < s && self.forced {
+            if i < s && forced {
                 forcing_at(i, z0, Some(false))
             } else {
                 Forcing::new()
             }
         });
-        let stateful = self.forced_stateful;
-        let total = |i: usize, z: &[Z3; 2]| {
-            let mut g = fixed[i];
-            if stateful {
-                g.add(&forcing_at(i, z, Some(true)));
-            }
-            g
-        };
+        let mut g = fixed;
+        let mut gt = [[SVector::<f64, 6>::zeros(); 3]; 3];
+        let mut stage_z = [*z0; 3];
+        let mut ys: [Six; 3] = [zb0; 3];
         let mut fp = FixedPoint::new();
-        let mut prev_r: Option<[FullVector; 3]> = None;
-        let mut g = [Forcing::new(); 3];
+        let mut prev_r: Option<[SVector<f64, 18>; 3]> = None;
         for it in 0..FORCED_MAX_ITERATIONS {
-            for i in 0..s {
-                g[i] = total(i, &stage_z[i]);
-            }
-            let gt: [FullVector; 3] =
-                std::array::from_fn(|j| pack_full(&g[j].g, 0.0).component_mul(&inv));
-            let mut rhs = SVector::<f64, NS>::zeros();
-            for i in 0..s {
-                let mut r = zb0;
-                for j in 0..s {
-                    r += gt[j] * (h * ta[i][j]);
+            if forced {
+                for i in 0..s {
+                    if stateful {
+                        g[i] = fixed[i];
+                        g[i].add(&forcing_at(i, &stage_z[i], Some(true)));
+                    }
+                    gt[i] = mul6(&to_six(&g[i].g), &inv);
                 }
-                rhs.fixed_rows_mut::<19>(19 * i).copy_from(&r);
             }
-            let Some(y) = lu.solve(&rhs) else {
+            let rhs: [Six; 3] = std::array::from_fn(|i| {
+                let mut r = f0.map(|v| v * (h * nodes[i]));
+                for j in 0..s {
+                    r = axpy(&r, &gt[j], h * ta[i][j]);
+                }
+                r
+            });
+            let Some(dy) = solver.solve(&rhs) else {
                 self.give_up(GaveUp::Singular);
                 return nan;
             };
-            let r: [FullVector; 3] = std::array::from_fn(|i| {
+            if !stateful {
+                // The stages do not feed back: this pass is the solution.
+                for i in 0..s {
+                    ys[i] = axpy(&zb0, &dy[i], 1.0);
+                    stage_z[i] = from_six(&mul6(&ys[i], &sc));
+                }
+                break;
+            }
+            let r: [SVector<f64, 18>; 3] = std::array::from_fn(|i| {
                 if i < s {
-                    y.fixed_rows::<19>(19 * i) - ys[i]
+                    flat(&axpy(&axpy(&zb0, &dy[i], 1.0), &ys[i], -1.0))
                 } else {
-                    FullVector::zeros()
+                    SVector::zeros()
                 }
             });
             if let Some(pr) = &prev_r {
@@ -228,10 +319,11 @@ impl VesselSystem<'_> {
             }
             let omega = fp.relax();
             for i in 0..s {
-                let yi = ys[i] + r[i] * omega;
-                fp.measure(r[i].as_slice(), yi.as_slice(), 18);
+                let yi: Six =
+                    std::array::from_fn(|c| ys[i][c] + r[i].fixed_rows::<6>(6 * c) * omega);
+                fp.measure(r[i].as_slice(), flat(&yi).as_slice(), 18);
                 ys[i] = yi;
-                stage_z[i] = unpack_full(&yi.component_mul(scale));
+                stage_z[i] = from_six(&mul6(&yi, &sc));
             }
             prev_r = Some(r);
             match fp.verdict(it, stateful) {
@@ -243,19 +335,23 @@ impl VesselSystem<'_> {
                 }
             }
         }
-        for i in 0..s {
-            g[i] = total(i, &stage_z[i]);
-        }
         let mut y1 = zb0;
         for i in 0..s {
-            y1 += (*a * ys[i] + pack_full(&g[i].g, 0.0).component_mul(&inv)) * (h * bw[i]);
+            if stateful {
+                g[i] = fixed[i];
+                g[i].add(&forcing_at(i, &stage_z[i], Some(true)));
+                gt[i] = mul6(&to_six(&g[i].g), &inv);
+            }
+            y1 = axpy(&y1, &axpy(&field(&ys[i]), &gt[i], 1.0), h * bw[i]);
         }
-        let z1 = unpack_full(&y1.component_mul(scale));
+        let z1 = from_six(&mul6(&y1, &sc));
         let mut work = Work::default();
         if let Some(booked) = &b.booked {
             for i in 0..s {
                 let mut p = self.power_at(booked, &stage_z[i]);
-                p += self.forcing_power(&g[i], &stage_z[i]);
+                if forced {
+                    p += self.forcing_power(&g[i], &stage_z[i]);
+                }
                 work += p.scaled(h * bw[i]);
             }
         }
