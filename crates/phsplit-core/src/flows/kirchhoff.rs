@@ -21,7 +21,8 @@
 //! every quadratic first integral exactly (E. Hairer, C. Lubich, G. Wanner, *Geometric Numerical
 //! Integration*, 2nd ed., Springer 2006, Theorem IV.2.2): `H` and both Casimirs, to the solve's
 //! tolerance and round-off. The stage equations are solved by Newton's method with the exact
-//! Jacobian (the field is quadratic in `u`). The attitude by the Runge–Kutta–Munthe-Kaas method
+//! Jacobian (the field is quadratic in `u`), kept factorised while the iteration contracts by 10
+//! or more a pass. The attitude by the Runge–Kutta–Munthe-Kaas method
 //! with the same Gauss coefficients (H. Munthe-Kaas, *BIT* 38 (1998) 92–111), on the body
 //! angular velocities of the stages: `Q1 = Q0 exp(Ω̂)` with
 //! `Ω_i = h Σ_j a_ij dexp⁻¹_{−Ω_j}(ω_j)`, `Ω = h Σ_j b_j dexp⁻¹_{−Ω_j}(ω_j)` and the closed form
@@ -137,6 +138,9 @@ impl Kirchhoff {
         nalgebra::Const<NS>: nalgebra::DimMin<nalgebra::Const<NS>, Output = nalgebra::Const<NS>>,
     {
         let mut y = [*u0; 3];
+        let mut lu: Option<nalgebra::linalg::LU<f64, nalgebra::Const<NS>, nalgebra::Const<NS>>> =
+            None;
+        let mut last_step = f64::INFINITY;
         for _ in 0..MAX_NEWTON {
             let f: [V6; 3] = std::array::from_fn(|i| {
                 if i < s {
@@ -146,7 +150,6 @@ impl Kirchhoff {
                 }
             });
             let mut res = SVector::<f64, NS>::zeros();
-            let mut jac = SMatrix::<f64, NS, NS>::identity();
             for i in 0..s {
                 let mut r = y[i] - u0;
                 for j in 0..s {
@@ -154,14 +157,20 @@ impl Kirchhoff {
                 }
                 res.fixed_rows_mut::<6>(6 * i).copy_from(&r);
             }
-            for j in 0..s {
-                let jf = self.jacobian(&y[j]);
-                for i in 0..s {
-                    let mut blk = jac.fixed_view_mut::<6, 6>(6 * i, 6 * j);
-                    blk -= jf * (h * a[i][j]);
+            // The Jacobian is refactorised only when the iteration does not contract fast
+            // (simplified Newton otherwise: E. Hairer, G. Wanner, *Solving ODEs II*, §IV.8).
+            if lu.is_none() {
+                let mut jac = SMatrix::<f64, NS, NS>::identity();
+                for j in 0..s {
+                    let jf = self.jacobian(&y[j]);
+                    for i in 0..s {
+                        let mut blk = jac.fixed_view_mut::<6, 6>(6 * i, 6 * j);
+                        blk -= jf * (h * a[i][j]);
+                    }
                 }
+                lu = Some(jac.lu());
             }
-            let dy = jac.lu().solve(&res)?;
+            let dy = lu.as_ref()?.solve(&res)?;
             let mut size: f64 = 0.0;
             let mut step: f64 = 0.0;
             for i in 0..s {
@@ -177,6 +186,10 @@ impl Kirchhoff {
             if step <= 2.0 * f64::EPSILON * size.max(f64::MIN_POSITIVE) {
                 return Some(y);
             }
+            if step > 0.1 * last_step {
+                lu = None;
+            }
+            last_step = step;
         }
         None
     }

@@ -1,19 +1,19 @@
 //! Flow S2 of the vessel over a sub-step (paper §3.4.2; docs/model.md §3.3, §3.5, §3.7): the
-//! exact flow of the two block systems (matrix exponential, ledger by the Van Loan Gramian),
-//! their Gauss collocation (the structured 3×3 solve, ledger by Gauss quadrature), and the
-//! Gauss collocation of S2 with a forcing part (time-dependent or non-affine components); and
-//! the same three for S2 as one coupled 18-dimensional system, where the mass matrix or a force
-//! couples translation and rotation (docs/model.md §5.14). A solve that gives up (a singular
-//! stage system, a fixed point that does not converge) yields NaN and records why
-//! ([`GaveUp`]), which the run's failure message says. The assembly of S2 from the components
-//! is `system.rs`'s.
+//! exact flow of the two block systems (matrix exponential, ledger by the Van Loan Gramian) and
+//! their Gauss collocation (the structured 3×3 solve, ledger by Gauss quadrature); S2 as one
+//! coupled 18-dimensional system, where the mass matrix or a force couples translation and
+//! rotation (docs/model.md §5.14), and the Gauss collocation of S2 with a forcing part
+//! (time-dependent or non-affine components), coupled or not, are `s2/coupled.rs`'s; the
+//! forcing's fixed point is here. A solve that gives up (a singular stage system, a fixed point
+//! that does not converge) yields NaN and records why ([`GaveUp`]), which the run's failure
+//! message says. The assembly of S2 from the components is `system.rs`'s.
 
 // Stage loops index the Butcher tableau `a_ij`, `b_i` and the blocks as the formulas write them.
 #![allow(clippy::needless_range_loop)]
 
-use super::super::forces::{Forcing, Frozen, Rows, S2Builder, Sys};
+use super::super::forces::{Rows, S2Builder, Sys};
 use super::super::state::VesselState;
-use super::{GaveUp, LinearFlow, VesselSystem};
+use super::{LinearFlow, VesselSystem};
 use crate::flows::affine;
 use crate::flows::collocation::{self as gauss, Blocks, Z3};
 use crate::solve::Work;
@@ -24,10 +24,6 @@ const FORCED_MAX_ITERATIONS: usize = 200;
 
 mod coupled;
 pub(super) use coupled::augmented;
-
-/// The stage system of at most three Gauss stages of one 10-dimensional block system.
-type Stages = SMatrix<f64, 30, 30>;
-type StageVector = SVector<f64, 30>;
 
 impl VesselSystem<'_> {
     /// Flow S2 over `h` from time `t` (paper §3.4.2): the two block systems at the frozen
@@ -47,10 +43,10 @@ impl VesselSystem<'_> {
         let fr = self.frozen(s, on);
         let b = self.s2_of(&fr, ledger);
         let z0 = self.blocks_of(s);
-        let (z1, work) = if b.cross.is_some() {
+        // A forcing part is collocated with the coupled system's solver whether or not the
+        // systems are coupled (their blocks of six are then block-diagonal).
+        let (z1, work) = if b.cross.is_some() || self.forced {
             self.coupled_s2(&fr, &b, &z0, h, t, stages)
-        } else if self.forced {
-            self.forced_gauss_s2(&fr, &b, &z0, h, t, stages)
         } else {
             match self.linear {
                 LinearFlow::Gauss => self.gauss_s2(&b, &z0, h, stages),
@@ -59,168 +55,6 @@ impl VesselSystem<'_> {
         };
         self.set_blocks(s, &z1);
         work
-    }
-
-    /// Gauss collocation with `s` stages of flow S2 with a forcing part:
-    /// `z' = Ā z + g(t, z)` on both block systems, `Z_i = z0 + h Σ_j a_ij (Ā Z_j + g(t + c_j h, Z_j))`,
-    /// `z1 = z0 + h Σ_i b_i (Ā Z_i + g_i)`. The linear part is implicit (one LU of the
-    /// balanced `10s × 10s` stage matrix per system), the forcing is iterated to a fixed point
-    /// (it converges at the rate `h² |∂g/∂x| / m`, tiny for the forces of a hull). The ledger
-    /// books each account's power at the stages with the weights `h b_i`, which is exact for
-    /// the collocation polynomial of a quadratic storage (Hairer–Lubich–Wanner, *Geometric
-    /// Numerical Integration*, §IV.2). A system that does not converge, or a singular stage
-    /// matrix, yields a non-finite state (the run then fails with what it had).
-    fn forced_gauss_s2(
-        &self,
-        fr: &Frozen,
-        b: &S2Builder,
-        z0: &[Z3; 2],
-        h: f64,
-        t: f64,
-        s: usize,
-    ) -> ([Z3; 2], Work) {
-        let nan = ([[Vector3::from_element(f64::NAN); 3]; 2], Work::default());
-        let (a, bw) = gauss::tableau(s);
-        let nodes: [f64; 3] = std::array::from_fn(|i| a[i].iter().sum());
-        let minv = self.minv();
-        let mut mats = [SMatrix::<f64, 10, 10>::zeros(); 2];
-        let mut scales = [SVector::<f64, 10>::zeros(); 2];
-        // The stage matrices I − h 𝒜⊗Ã, on the stack: three stages at most, the unused ones
-        // left as identity rows (their stages come out zero and are not read).
-        let lus = std::array::from_fn::<_, 2, _>(|k| {
-            let scale = balance(&b.sys[k], &minv[k]);
-            let abar = b.sys[k].augmented();
-            let at = SMatrix::<f64, 10, 10>::from_fn(|i, j| abar[(i, j)] * scale[j] / scale[i]);
-            let mut m = Stages::identity();
-            for i in 0..s {
-                for j in 0..s {
-                    let mut v = m.fixed_view_mut::<10, 10>(10 * i, 10 * j);
-                    v -= at * (h * a[i][j]);
-                }
-            }
-            mats[k] = at;
-            scales[k] = scale;
-            m.lu()
-        });
-        let pack = |z: &Z3, k: usize, one: f64| {
-            let mut out = SVector::<f64, 10>::zeros();
-            for (i, v) in z.iter().enumerate() {
-                out.fixed_rows_mut::<3>(3 * i).copy_from(v);
-            }
-            out[9] = one;
-            out.component_div(&scales[k])
-        };
-        let unpack = |y: &SVector<f64, 10>, k: usize| -> Z3 {
-            let z = y.component_mul(&scales[k]);
-            [
-                z.fixed_rows::<3>(0).into_owned(),
-                z.fixed_rows::<3>(3).into_owned(),
-                z.fixed_rows::<3>(6).into_owned(),
-            ]
-        };
-        let z0t = [pack(&z0[0], 0, 1.0), pack(&z0[1], 1, 1.0)];
-        let mut stage_z = [*z0; 3];
-        // The stage iterates, balanced, starting from z0 (as stage_z does).
-        let mut ys: [[SVector<f64, 10>; 3]; 2] = std::array::from_fn(|k| {
-            std::array::from_fn(|i| if i < s { z0t[k] } else { SVector::zeros() })
-        });
-        let mut g = [Forcing::new(); 3];
-        // The parts that depend on time only, once per stage; the rest per pass.
-        let fixed: [Forcing; 3] = std::array::from_fn(|i| {
-            if i < s {
-                self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(false))
-            } else {
-                Forcing::new()
-            }
-        });
-        let stateful = self.forced_stateful;
-        let mut fp = FixedPoint::new();
-        let mut prev_r: Option<[[SVector<f64, 10>; 3]; 2]> = None;
-        for it in 0..FORCED_MAX_ITERATIONS {
-            for i in 0..s {
-                g[i] = fixed[i];
-                if stateful {
-                    g[i].add(&self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true)));
-                }
-            }
-            let mut r = [[SVector::<f64, 10>::zeros(); 3]; 2];
-            for k in 0..2 {
-                let gt: [SVector<f64, 10>; 3] = std::array::from_fn(|j| {
-                    if j < s {
-                        pack(&g[j].g[k], k, 0.0)
-                    } else {
-                        SVector::zeros()
-                    }
-                });
-                let mut rhs = StageVector::zeros();
-                for i in 0..s {
-                    let mut r = z0t[k];
-                    for j in 0..s {
-                        r += gt[j] * (h * a[i][j]);
-                    }
-                    rhs.fixed_rows_mut::<10>(10 * i).copy_from(&r);
-                }
-                let Some(y) = lus[k].solve(&rhs) else {
-                    self.give_up(GaveUp::Singular);
-                    return nan;
-                };
-                for i in 0..s {
-                    r[k][i] = y.fixed_rows::<10>(10 * i) - ys[k][i];
-                }
-            }
-            if let Some(pr) = &prev_r {
-                for k in 0..2 {
-                    for i in 0..s {
-                        fp.compare(r[k][i].as_slice(), pr[k][i].as_slice());
-                    }
-                }
-            }
-            let omega = fp.relax();
-            for k in 0..2 {
-                for i in 0..s {
-                    let yi = ys[k][i] + r[k][i] * omega;
-                    fp.measure(r[k][i].as_slice(), yi.as_slice(), 9);
-                    ys[k][i] = yi;
-                    stage_z[i][k] = unpack(&yi, k);
-                }
-            }
-            prev_r = Some(r);
-            match fp.verdict(it, stateful) {
-                Verdict::Continue => {}
-                Verdict::Converged => break,
-                Verdict::Failed => {
-                    self.give_up(GaveUp::Forcing);
-                    return nan;
-                }
-            }
-        }
-        for i in 0..s {
-            g[i] = fixed[i];
-            if stateful {
-                g[i].add(&self.forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true)));
-            }
-        }
-        let mut z1 = [[Vector3::zeros(); 3]; 2];
-        for k in 0..2 {
-            let mut y1 = z0t[k];
-            for i in 0..s {
-                y1 += (mats[k] * ys[k][i] + pack(&g[i].g[k], k, 0.0)) * (h * bw[i]);
-            }
-            z1[k] = unpack(&y1, k);
-        }
-        let mut work = Work::default();
-        if let Some(booked) = &b.booked {
-            for i in 0..s {
-                let mut p = self.power_at(booked, &stage_z[i]);
-                p += self.forcing_power(&g[i], &stage_z[i]);
-                work += p.scaled(h * bw[i]);
-            }
-        }
-        let finite = z1.iter().flatten().all(|v| v.iter().all(|x| x.is_finite()));
-        if !finite {
-            return nan;
-        }
-        (z1, work)
     }
 
     /// Gauss collocation on the block systems; the ledger by the Gauss quadrature of the

@@ -228,11 +228,19 @@ impl VesselSystem<'_> {
         (unpack_full(&zb1.component_mul(scale)), work)
     }
 
-    /// The Gauss collocation of [`Self::coupled_s2`] with `s` stages, balanced by `scale`. The
-    /// stage equations keep the block structure of flow S2 with blocks of six ([`six_blocks`])
-    /// and are solved for the stage increments by the transformed, reduced `6 × 6` systems of
-    /// [`StageSolver`], factorised once per sub-step and solved once per pass of the forcing's
-    /// fixed point.
+    /// Gauss collocation with `s` stages of flow S2, coupled or not, with its forcing part:
+    /// `z' = Ā z + g(t, z)`, `Z_i = z0 + h Σ_j a_ij (Ā Z_j + g(t + c_j h, Z_j))`,
+    /// `z1 = z0 + h Σ_i b_i (Ā Z_i + g_i)`, balanced by `scale`. The linear part is implicit, the
+    /// forcing is iterated to a fixed point ([`FixedPoint`]: it converges at the rate
+    /// `h² |∂g/∂x| / m`, tiny for the forces of a hull, and the components put the stiff part of
+    /// theirs in the implicit rows). The stage equations keep the block structure of flow S2 with
+    /// blocks of six ([`six_blocks`]) and are solved for the stage increments by the
+    /// transformed, reduced `6 × 6` systems of [`StageSolver`], factorised once per sub-step and
+    /// solved once per pass. The ledger books each account's power at the stages with the
+    /// weights `h b_i`, which is exact for the collocation polynomial of a quadratic storage
+    /// (Hairer–Lubich–Wanner, *Geometric Numerical Integration*, §IV.2). A singular reduced
+    /// system or a fixed point that does not converge yields a non-finite state (the run then
+    /// fails with what it had, and says why).
     #[allow(clippy::too_many_arguments)]
     fn coupled_collocation(
         &self,
