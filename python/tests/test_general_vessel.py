@@ -228,7 +228,7 @@ def test_the_presets_on_the_command_line_and_in_scenarios(tmp_path, capsys):
         np.testing.assert_allclose(ds["velocity"].values, nu[:, :3], rtol=1e-10, atol=1e-14)
         np.testing.assert_allclose(ds["angular_velocity"].values, nu[:, 3:], rtol=1e-10, atol=1e-16)
     assert cli.main(["simulate", "--vessel", "osw", "--out", str(tmp_path)]) == 2
-    assert "neither a file nor a shipped vessel (shipped: paper, osv)" in capsys.readouterr().err
+    assert "neither a file nor a shipped vessel (shipped: paper, osv, supply)" in capsys.readouterr().err
 
 
 def test_a_vessel_file_with_full_matrices_in_a_scenario(tmp_path):

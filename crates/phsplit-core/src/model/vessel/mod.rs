@@ -43,6 +43,11 @@ pub const PRESETS: &[(&str, &str, &str)] = &[
         "83 m offshore supply vessel of Fossen's MSS (osv.m): full added mass, CG 4.5 m aft, cross-flow drag",
         include_str!("../../../data/vessels/osv.toml"),
     ),
+    (
+        "supply",
+        "82.8 m supply vessel of MSS's ShipX data, the paper's vessel with its added mass, CG 5.4 m aft, full damping and restoring",
+        include_str!("../../../data/vessels/supply.toml"),
+    ),
 ];
 
 /// The default initial state, in engineering variables (table `[initial]`).
