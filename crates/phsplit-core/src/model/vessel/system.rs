@@ -172,15 +172,27 @@ impl<'a> VesselSystem<'a> {
     /// (`Some(false)`), or of all (`None`).
     fn forcing_of(&self, fr: &Frozen, t: f64, z: &[Z3; 2], uses_state: Option<bool>) -> Forcing {
         let mut g = Forcing::new();
+        self.add_forcing_of(fr, t, z, uses_state, &mut g);
+        g
+    }
+
+    /// [`Self::forcing_of`], added to `g`.
+    fn add_forcing_of(
+        &self,
+        fr: &Frozen,
+        t: f64,
+        z: &[Z3; 2],
+        uses_state: Option<bool>,
+        g: &mut Forcing,
+    ) {
         if self.forced {
             for (f, base) in self.vessel.forces.iter().zip(&self.bases) {
                 if f.forced() && uses_state.is_none_or(|u| u == f.forcing_uses_state()) {
                     g.base = *base;
-                    f.add_forcing(fr, t, z, &mut g);
+                    f.add_forcing(fr, t, z, g);
                 }
             }
         }
-        g
     }
 
     /// The same system keeping (or not) the running maxima of the controller's force and

@@ -24,10 +24,12 @@
 //! current's work through this hull, the port `crossflow_current` (supplied; either sign).
 //!
 //! **In flow S2** it is a forcing (Gauss collocation at the stages, §3.7, whose energy balance
-//! is exact for the quadratic `H`, the dissipation booked `≥ 0` at the stages). Its sway–sway
-//! and yaw–yaw derivatives at the sub-step's start are put in the implicit rows and taken out of
-//! the forcing (their sum is the force), which keeps the fixed point contractive at long steps;
-//! the sway–yaw couplings stay in the forcing (they join the two block systems).
+//! is exact for the quadratic `H`, the dissipation booked `≥ 0` at the stages). Its Jacobian at
+//! the sub-step's start, `−2k ∫|s| [1, x; x, x²] dx` (symmetric, negative semidefinite: a linear
+//! damping), is put in the implicit rows and taken out of the forcing (their sum is the force),
+//! which keeps the fixed point contractive at long steps and leaves it only the drag's
+//! second-order remainder. Its sway–yaw terms join translation and rotation (flow S2 is then
+//! one coupled system, docs/model.md §5.14, which a forced S2 is solved as anyway).
 
 use super::current::Current;
 use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
@@ -97,10 +99,10 @@ const ACCOUNTS: [Account; 2] = [
     },
 ];
 
-/// On one piece `[x1, x2]` where `s = a + b x` keeps its sign: `(∫s², ∫x s², ∫s, ∫x² s)`,
+/// On one piece `[x1, x2]` where `s = a + b x` keeps its sign: `(∫s², ∫x s², ∫s, ∫x² s, ∫x s)`,
 /// expanded in the moments `m_e = (x2^e − x1^e)/e` (exact polynomial integrals, no division by
 /// `b`: no cancellation as `b → 0`).
-fn piece(a: f64, b: f64, x1: f64, x2: f64) -> [f64; 4] {
+fn piece(a: f64, b: f64, x1: f64, x2: f64) -> [f64; 5] {
     let (p1, q1) = (x1, x2);
     let (p2, q2) = (p1 * x1, q1 * x2);
     let (p3, q3) = (p2 * x1, q2 * x2);
@@ -112,17 +114,18 @@ fn piece(a: f64, b: f64, x1: f64, x2: f64) -> [f64; 4] {
         aa * m[1] + ab * m[2] + bb * m[3],
         a * m[0] + b * m[1],
         a * m[2] + b * m[3],
+        a * m[1] + b * m[2],
     ]
 }
 
 /// The strip integrals of `s = a + b x` over `[x1, x2]`:
-/// `(∫|s|s, ∫x|s|s, ∫|s|, ∫x²|s|)`, exact: `|s|s = ±s²` and `|s| = ±s` on each side of the
+/// `(∫|s|s, ∫x|s|s, ∫|s|, ∫x²|s|, ∫x|s|)`, exact: `|s|s = ±s²` and `|s| = ±s` on each side of the
 /// zero `x0 = −a/b`, so the interval is split there.
-pub fn strip_integrals(a: f64, b: f64, x1: f64, x2: f64) -> [f64; 4] {
+pub fn strip_integrals(a: f64, b: f64, x1: f64, x2: f64) -> [f64; 5] {
     let x0 = if b != 0.0 { -a / b } else { f64::NAN };
     let split = x0 > x1 && x0 < x2;
     let cuts = if split { [x1, x0, x2] } else { [x1, x2, x2] };
-    let mut out = [0.0; 4];
+    let mut out = [0.0; 5];
     for w in cuts.windows(2).take(if split { 2 } else { 1 }) {
         let mid = 0.5 * (w[0] + w[1]);
         let sign = (a + b * mid).signum();
@@ -141,10 +144,12 @@ impl CrossflowDrag {
         (-self.k * i[0], -self.k * i[1])
     }
 
-    /// `∂Y/∂v` and `∂N/∂r` (≤ 0).
-    fn diagonal_derivatives(&self, v: f64, r: f64) -> (f64, f64) {
+    /// The Jacobian of `(Y, N)` in `(v, r)`, `−2k ∫ |s| [1, x; x, x²] dx`: symmetric and
+    /// negative semidefinite (minus a Gram matrix), as `(∂Y/∂v, ∂Y/∂r = ∂N/∂v, ∂N/∂r)`.
+    fn jacobian(&self, v: f64, r: f64) -> (f64, f64, f64) {
         let i = strip_integrals(v, r, self.x_aft, self.x_fore);
-        (-2.0 * self.k * i[2], -2.0 * self.k * i[3])
+        let c = -2.0 * self.k;
+        (c * i[2], c * i[4], c * i[3])
     }
 
     /// The sway velocity of the water in the body frame at time `t`.
@@ -162,15 +167,21 @@ impl Force for CrossflowDrag {
     fn accounts(&self) -> &'static [Account] {
         &ACCOUNTS
     }
-    /// The sway–sway and yaw–yaw derivatives at the sub-step's start, as implicit rows.
+    /// The drag's Jacobian at the sub-step's start, as implicit rows: a symmetric positive
+    /// semidefinite linear damping on `(v, r)` (its sway–yaw terms join translation and rotation).
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
-        let (dv, dr) = self.diagonal_derivatives(fr.velocity[0].y, fr.velocity[1].z);
-        let mut ft = Matrix3::zeros();
-        ft[(1, 1)] = dv;
-        let mut fr_ = Matrix3::zeros();
-        fr_[(2, 2)] = dr;
-        b.force(Sys::Trans, Some(0), &Rows::on_velocity(Sys::Trans, ft));
-        b.force(Sys::Rot, Some(0), &Rows::on_velocity(Sys::Rot, fr_));
+        let (dv, dvr, dr) = self.jacobian(fr.velocity[0].y, fr.velocity[1].z);
+        let at = |i: usize, j: usize, x: f64| {
+            let mut m = Matrix3::zeros();
+            m[(i, j)] = x;
+            m
+        };
+        let rows = |t: Matrix3<f64>, r: Matrix3<f64>| Rows {
+            fnu: [t, r],
+            ..Rows::ZERO
+        };
+        b.force(Sys::Trans, Some(0), &rows(at(1, 1, dv), at(1, 2, dvr)));
+        b.force(Sys::Rot, Some(0), &rows(at(2, 1, dvr), at(2, 2, dr)));
     }
     fn forced(&self) -> bool {
         true
@@ -180,10 +191,18 @@ impl Force for CrossflowDrag {
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
         let nu = fr.nu(z);
         let (v, r) = (nu[0].y, nu[1].z);
-        let (dv, dr) = self.diagonal_derivatives(fr.velocity[0].y, fr.velocity[1].z);
+        let (dv, dvr, dr) = self.jacobian(fr.velocity[0].y, fr.velocity[1].z);
         let (y, n) = self.load(v, r);
-        g.force(Sys::Trans, Some(0), Vector3::new(0.0, y - dv * v, 0.0));
-        g.force(Sys::Rot, Some(0), Vector3::new(0.0, 0.0, n - dr * r));
+        g.force(
+            Sys::Trans,
+            Some(0),
+            Vector3::new(0.0, y - dv * v - dvr * r, 0.0),
+        );
+        g.force(
+            Sys::Rot,
+            Some(0),
+            Vector3::new(0.0, 0.0, n - dvr * v - dr * r),
+        );
         if self.current.is_some() {
             let (yr, nr) = self.load(v - self.water_sway(fr, t), r);
             g.force(Sys::Trans, Some(1), Vector3::new(0.0, yr - y, 0.0));
@@ -210,7 +229,7 @@ mod tests {
         for (a, b, x1, x2) in cases {
             let n = 200_000;
             let dx = (x2 - x1) / n as f64;
-            let mut want = [0.0; 4];
+            let mut want = [0.0; 5];
             for i in 0..n {
                 let x = x1 + (i as f64 + 0.5) * dx;
                 let s: f64 = a + b * x;
@@ -218,9 +237,10 @@ mod tests {
                 want[1] += x * s.abs() * s * dx;
                 want[2] += s.abs() * dx;
                 want[3] += x * x * s.abs() * dx;
+                want[4] += x * s.abs() * dx;
             }
             let got = strip_integrals(a, b, x1, x2);
-            for k in 0..4 {
+            for k in 0..5 {
                 let scale = want[k].abs().max(1e-300);
                 // the midpoint rule's own error at the kink and of order dx²
                 assert!(
@@ -250,6 +270,32 @@ mod tests {
         for (v, r) in [(0.3, -0.02), (-1.0, 0.05), (0.0, 0.01), (0.5, 0.0)] {
             let (y, n) = d.load(v, r);
             assert!(v * y + r * n <= 0.0);
+        }
+    }
+
+    /// The Jacobian against central differences of the loads, and symmetric negative
+    /// semidefinite.
+    #[test]
+    fn the_jacobian_is_the_loads_derivative() {
+        let d = CrossflowDrag {
+            k: 0.5 * 1025.0 * 5.0 * 0.7,
+            x_aft: -40.0,
+            x_fore: 36.0,
+            current: None,
+        };
+        for (v, r) in [(0.3, -0.02), (-1.0, 0.05), (0.2, 0.0), (0.0, 0.01)] {
+            let (dv, dvr, dr) = d.jacobian(v, r);
+            let (ev, er) = (1e-6, 1e-8);
+            let (yp, np) = d.load(v + ev, r);
+            let (ym, nm) = d.load(v - ev, r);
+            let (yq, nq) = d.load(v, r + er);
+            let (yn, nn) = d.load(v, r - er);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-6 * a.abs().max(b.abs()).max(1.0);
+            assert!(close(dv, (yp - ym) / (2.0 * ev)), "{v} {r}");
+            assert!(close(dvr, (yq - yn) / (2.0 * er)), "{v} {r}");
+            assert!(close(dvr, (np - nm) / (2.0 * ev)), "{v} {r}");
+            assert!(close(dr, (nq - nn) / (2.0 * er)), "{v} {r}");
+            assert!(dv <= 0.0 && dr <= 0.0 && dv * dr >= dvr * dvr * (1.0 - 1e-12));
         }
     }
 }

@@ -311,18 +311,6 @@ impl Forcing {
     pub fn rate_w(&mut self, sys: Sys, r: Vector3<f64>) {
         self.g[sys as usize][2] += r;
     }
-    /// Add another forcing (of other components) to this one.
-    pub(crate) fn add(&mut self, o: &Forcing) {
-        for k in 0..2 {
-            for i in 0..3 {
-                self.g[k][i] += o.g[k][i];
-            }
-        }
-        for (a, b) in self.booked.iter_mut().zip(o.booked.iter()) {
-            a[0] += b[0];
-            a[1] += b[1];
-        }
-    }
 }
 
 /// A named scalar a component reports at a state, for the results (CF units).
