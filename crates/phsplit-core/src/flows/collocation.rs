@@ -446,6 +446,12 @@ pub fn blocks_step(sys: &Blocks, z0: &Z3, h: f64, s: usize) -> Option<(Z3, [Z3; 
         .then_some((z1, stages))
 }
 
+/// `d = bᵀ𝒜⁻¹` of the `s`-stage Gauss method: where the stages solve their equations,
+/// `z1 = z0 + Σ_i d_i (Z_i − z0)` (for `s = 1`, `d = 2`: `z1 = 2 Z − z0`).
+pub fn update_weights(s: usize) -> [f64; 3] {
+    transformed(s).d
+}
+
 /// The weights `b` of the `s`-stage Gauss method.
 pub fn weights(s: usize) -> [f64; 3] {
     tableau(s).1

@@ -22,7 +22,8 @@
 //! Integration*, 2nd ed., Springer 2006, Theorem IV.2.2): `H` and both Casimirs, to the solve's
 //! tolerance and round-off. The stage equations are solved by Newton's method with the exact
 //! Jacobian (the field is quadratic in `u`), kept factorised while the iteration contracts by 10
-//! or more a pass. The attitude by the Runge–Kutta–Munthe-Kaas method
+//! or more a pass; a slow rotation (`h|ω|` small) is left to functional iteration while that
+//! contracts by 10 a pass. The attitude by the Runge–Kutta–Munthe-Kaas method
 //! with the same Gauss coefficients (H. Munthe-Kaas, *BIT* 38 (1998) 92–111), on the body
 //! angular velocities of the stages: `Q1 = Q0 exp(Ω̂)` with
 //! `Ω_i = h Σ_j a_ij dexp⁻¹_{−Ω_j}(ω_j)`, `Ω = h Σ_j b_j dexp⁻¹_{−Ω_j}(ω_j)` and the closed form
@@ -141,6 +142,9 @@ impl Kirchhoff {
         let mut lu: Option<nalgebra::linalg::LU<f64, nalgebra::Const<NS>, nalgebra::Const<NS>>> =
             None;
         let mut last_step = f64::INFINITY;
+        // Functional iteration while it contracts by 10 a pass (a slow rotation: its rate is
+        // about h|ω|), then Newton's method.
+        let mut newton = false;
         for _ in 0..MAX_NEWTON {
             let f: [V6; 3] = std::array::from_fn(|i| {
                 if i < s {
@@ -149,6 +153,28 @@ impl Kirchhoff {
                     V6::zeros()
                 }
             });
+            if !newton {
+                let mut size: f64 = 0.0;
+                let mut step: f64 = 0.0;
+                for i in 0..s {
+                    let mut yi = *u0;
+                    for j in 0..s {
+                        yi += f[j] * (h * a[i][j]);
+                    }
+                    step = step.max((yi - y[i]).amax());
+                    size = size.max(yi.amax());
+                    y[i] = yi;
+                }
+                if !step.is_finite() {
+                    return None;
+                }
+                if step <= 2.0 * f64::EPSILON * size.max(f64::MIN_POSITIVE) {
+                    return Some(y);
+                }
+                newton = step > 0.1 * last_step;
+                last_step = step;
+                continue;
+            }
             let mut res = SVector::<f64, NS>::zeros();
             for i in 0..s {
                 let mut r = y[i] - u0;

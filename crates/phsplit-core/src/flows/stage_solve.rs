@@ -100,15 +100,21 @@ where
             .any(|v| *v != 0.0)
             .then(|| st.auw * (st.awv * st.avu));
         // Re and Im of S(μ), from the real blocks.
-        let parts = |mu: Complex<f64>| {
+        let real_part = |mu: Complex<f64>| {
             let (m2, m3) = (mu * mu, mu * mu * mu);
             let mut re = SMatrix::<f64, D, D>::identity() - st.auu * mu.re - p2 * m2.re;
-            let mut im = -(st.auu * mu.im + p2 * m2.im);
             if let Some(p3) = &p3 {
                 re -= p3 * m3.re;
+            }
+            re
+        };
+        let parts = |mu: Complex<f64>| {
+            let (m2, m3) = (mu * mu, mu * mu * mu);
+            let mut im = -(st.auu * mu.im + p2 * m2.im);
+            if let Some(p3) = &p3 {
                 im -= p3 * m3.im;
             }
-            (re, im)
+            (real_part(mu), im)
         };
         let mut real = None;
         let mut pair = None;
@@ -119,7 +125,7 @@ where
                 let lu = re.zip_map(&im, Complex::new).lu();
                 pair = Some((Reduced { mu, lu }, k));
             } else {
-                let lu = parts(Complex::from(mu.re)).0.lu();
+                let lu = real_part(Complex::from(mu.re)).lu();
                 real = Some((Reduced { mu: mu.re, lu }, k));
             }
         }

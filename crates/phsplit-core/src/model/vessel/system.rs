@@ -84,6 +84,8 @@ pub struct VesselSystem<'a> {
     forced: bool,
     /// Whether a component's forcing depends on the state (else one pass solves the stages).
     forced_stateful: bool,
+    /// Whether a component's forcing depends on time only (evaluated once per stage).
+    forced_timed: bool,
     /// Why a sub-flow gave up (a [`GaveUp`] code; 0: none), for the run's failure message.
     gave_up: std::sync::Arc<std::sync::atomic::AtomicU8>,
 }
@@ -132,6 +134,10 @@ impl<'a> VesselSystem<'a> {
                 .forces
                 .iter()
                 .any(|f| f.forced() && f.forcing_uses_state()),
+            forced_timed: vessel
+                .forces
+                .iter()
+                .any(|f| f.forced() && !f.forcing_uses_state()),
             gave_up: Default::default(),
         }
     }
@@ -255,7 +261,7 @@ impl<'a> VesselSystem<'a> {
 
     /// Flow S2 at the frozen view `fr` ([`Self::s2_at`]).
     fn s2_of(&self, fr: &Frozen, ledger: bool) -> S2Builder {
-        let mut b = S2Builder::new(ledger);
+        let mut b = S2Builder::new(ledger.then_some(self.accounts.len()));
         // The kinematics of the position, x' = Q v: the body's, not a force's.
         b.rate_v(Sys::Trans, Sys::Trans, &fr.q);
         for (f, base) in self.vessel.forces.iter().zip(&self.bases) {
@@ -329,7 +335,7 @@ impl<'a> VesselSystem<'a> {
     }
 
     /// Power per account at block states `z`, from the booked rows: `±(M⁻¹u)·f`.
-    fn power_at(&self, booked: &[[Rows; 2]; MAX_ACCOUNTS], z: &[Z3; 2]) -> Work {
+    fn power_at(&self, booked: &[[Rows; 2]], z: &[Z3; 2]) -> Work {
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
         let mut w = Work::default();
         for k in 0..self.accounts.len() {

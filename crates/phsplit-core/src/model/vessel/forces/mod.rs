@@ -179,14 +179,15 @@ pub struct S2Builder {
     /// After [`Self::finish`], when the systems are coupled: for each system `k`, the rows of
     /// `u_k'` and of `v_k'` on the other system's momentum, and of `u_k'` on its `v`.
     pub cross: Option<[[Matrix3<f64>; 3]; 2]>,
-    /// Force rows per account and system (only with `ledger`).
-    pub booked: Option<Box<[[Rows; 2]; MAX_ACCOUNTS]>>,
+    /// Force rows per account and system (only with the ledger: one per account of the run).
+    pub booked: Option<Vec<[Rows; 2]>>,
     /// First account of the component being assembled.
     pub(crate) base: usize,
 }
 
 impl S2Builder {
-    pub(crate) fn new(ledger: bool) -> Self {
+    /// A builder booking to `accounts` accounts (`None`: without the ledger).
+    pub(crate) fn new(accounts: Option<usize>) -> Self {
         let zero = Blocks {
             auu: Matrix3::zeros(),
             auv: Matrix3::zeros(),
@@ -202,7 +203,7 @@ impl S2Builder {
             nu_v: [[Matrix3::zeros(); 2]; 2],
             other_v: [Matrix3::zeros(); 2],
             cross: None,
-            booked: ledger.then(|| Box::new([[Rows::ZERO; 2]; MAX_ACCOUNTS])),
+            booked: accounts.map(|n| vec![[Rows::ZERO; 2]; n]),
             base: 0,
         }
     }

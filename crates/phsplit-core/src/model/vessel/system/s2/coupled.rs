@@ -292,18 +292,18 @@ impl VesselSystem<'_> {
         let f0 = field(&zb0);
         let forced = self.forced;
         let stateful = self.forced_stateful;
-        let forcing_at = |i: usize, z: &[Z3; 2], uses: Option<bool>| {
-            self.forcing_of(fr, t + nodes[i] * h, z, uses)
-        };
-        // The parts of the forcing that depend on time only, once per stage; the rest per pass.
-        let fixed: [Forcing; 3] = std::array::from_fn(|i| {
-            if i < s && forced {
-                forcing_at(i, z0, Some(false))
-            } else {
-                Forcing::new()
+        // The parts of the forcing that depend on time only, once per stage (in `fixed`); the
+        // rest per pass, added to them in `g`.
+        let mut fixed = [Forcing::new(); 3];
+        if self.forced_timed {
+            for i in 0..s {
+                self.add_forcing_of(fr, t + nodes[i] * h, z0, Some(false), &mut fixed[i]);
             }
-        });
-        let mut g = fixed;
+        }
+        let mut g = [Forcing::new(); 3];
+        if !stateful {
+            g[..s].copy_from_slice(&fixed[..s]);
+        }
         let mut gt = [[SVector::<f64, 6>::zeros(); 3]; 3];
         let mut stage_z = [*z0; 3];
         let mut ys: [Six; 3] = [zb0; 3];
@@ -387,13 +387,23 @@ impl VesselSystem<'_> {
             }
         }
         let mut y1 = zb0;
-        for i in 0..s {
-            if stateful && !current {
+        if stateful && !current {
+            // The stages are converged to the fixed point's tolerance: the update takes the
+            // field and the forcing at them.
+            for i in 0..s {
                 g[i] = fixed[i];
                 self.add_forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true), &mut g[i]);
                 gt[i] = mul6(&to_six(&g[i].g), &inv);
+                y1 = axpy(&y1, &axpy(&field(&ys[i]), &gt[i], 1.0), h * bw[i]);
             }
-            y1 = axpy(&y1, &axpy(&field(&ys[i]), &gt[i], 1.0), h * bw[i]);
+        } else {
+            // The stages solve the stage equations with the forcing `g` at them (to round-off):
+            // `h Σ_j a_ij F_j = ΔY_i`, so `z1 = z0 + h Σ b_i F_i = z0 + Σ_i d_i ΔY_i` with
+            // `d = bᵀ𝒜⁻¹`, without evaluating the field again.
+            let d = gauss::update_weights(s);
+            for i in 0..s {
+                y1 = axpy(&y1, &axpy(&ys[i], &zb0, -1.0), d[i]);
+            }
         }
         let z1 = from_six(&mul6(&y1, &sc));
         let mut work = Work::default();
