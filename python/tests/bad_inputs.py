@@ -379,6 +379,9 @@ CATALOGUE += [
 CATALOGUE += [
     Bad("centre of flotation far off the hull", vessel_with("gravity = 9.81", "gravity = 9.81\nflotation_center_x = 5000.0"),
         E, ("vessel.flotation_center_x", "±1000 m")),
+    Bad("centre of flotation far off the centreline",
+        vessel_with("gravity = 9.81", "gravity = 9.81\nflotation_center_y = -2500.0"),
+        E, ("vessel.flotation_center_y", "±1000 m")),
 ]
 
 CATALOGUE += [

@@ -53,7 +53,8 @@ class Vessel:
         self.heave = h["gravity"] * h["water_density"] * h["waterplane_area"]
         w = m * h["gravity"]
         self.G = np.array([w * h["gm_longitudinal"], w * h["gm_transverse"], 0.0])
-        self.xf = h.get("flotation_center_x", 0.0)  # the heave spring acts at the centre of flotation
+        # the heave spring acts at the centre of flotation (x_F, y_F, 0)
+        self.rf = np.array([h.get("flotation_center_x", 0.0), h.get("flotation_center_y", 0.0), 0.0])
         c = params["control"]
         k = 1.0 if control_on else 0.0
         self.K = {n: k * np.diag(c[n]) for n in ("kp_translational", "kd_translational", "ki_translational",
@@ -103,9 +104,9 @@ class Vessel:
             -Q.T @ (K["kp_translational"] @ (x - self.xr) + K["kd_translational"] @ (Q @ v) + K["ki_translational"] @ phx),
             -W.T @ (K["kp_rotational"] @ (th - self.thr) + K["kd_rotational"] @ (W @ w) + K["ki_rotational"] @ phth),
         ])
-        # V = c/2 (z + x_F q3_x)^2 + q3^T G q3 / 2: z_F is the height of the centre of flotation
-        zf = x[2] + self.xf * q3[0]
-        dv_dq3 = self.G * q3 + np.array([self.heave * zf * self.xf, 0.0, 0.0])
+        # V = c/2 (z + r_F . q3)^2 + q3^T G q3 / 2: z_F is the height of the centre of flotation
+        zf = x[2] + self.rf @ q3
+        dv_dq3 = self.G * q3 + self.heave * zf * self.rf
         g = np.concatenate([q3 * self.heave * zf, np.cross(dv_dq3, q3)])
         rhs = tau - self.coriolis(nu) @ nu - self.D @ nu - self.cq * np.abs(nu) * nu + self.crossflow(nu) - g
         dy = np.empty(24)

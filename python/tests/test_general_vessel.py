@@ -101,6 +101,67 @@ def test_the_natural_periods_are_those_of_fossens_linear_model():
     assert np.max(np.abs(np.array(other) - want) / np.array(want)) > 1e-4
 
 
+def fossen_restoring(c, gt, gl, rf_fossen):
+    """Fossen's restoring matrix about the CO from the centre of flotation r (Fossen's frame),
+    G = H(r)^T diag(0, 0, c, G_T, G_L, 0) H(r), H(r) = [[I, S(r)^T], [0, I]] (Fossen 2021, §4.2)."""
+    H = np.block([[np.eye(3), fossen.S(np.asarray(rf_fossen, float)).T], [np.zeros((3, 3)), np.eye(3)]])
+    return H.T @ np.diag([0.0, 0.0, c, gt, gl, 0.0]) @ H
+
+
+def asymmetric_osv(yf=1.5):
+    t = OSV.to_dict()
+    t["vessel"]["flotation_center_y"] = yf
+    return phsplit.Vessel.from_dict(t)
+
+
+def test_a_flotation_centre_off_the_centreline_gives_fossens_coupling_terms():
+    """A hull that is not port-starboard symmetric: with the centre of flotation at (x_F, y_F),
+    the undamped, uncontrolled natural periods are those of M nu' + G eta = 0 with Fossen's
+    G = H(r)^T G_CF H(r) (G34, G35, G45 and the shifted G44, G55), r = (x_F, -y_F, 0) in his
+    frame (y to starboard), converted to z up."""
+    pub = osv_published()
+    t = asymmetric_osv().to_dict()
+    t["vessel"]["damping_translational"] = [0.0] * 3
+    t["vessel"]["damping_rotational"] = [0.0] * 3
+    del t["crossflow_drag"]
+    got = phsplit.Vessel.from_dict(t).natural_periods(control=False, euler=[0.0, 0.0, 0.0])
+    rho_g = 1025.0 * 9.81
+    vol = pub["m"] / 1025.0
+    G = fossen_restoring(rho_g * pub["awp"], rho_g * vol * pub["gmt"], rho_g * vol * pub["gml"], [-0.5, -1.5, 0.0])
+    assert G[2, 3] != 0 and G[3, 4] != 0  # the couplings of an asymmetric hull
+    lam = np.linalg.eigvals(np.linalg.solve(pub["M"], G))
+    want = sorted(2 * np.pi / np.sqrt(lam.real[lam.real > 1e-9]))
+    assert len(got) == 3 and len(want) == 3
+    np.testing.assert_allclose(got, want, rtol=1e-9)
+    # with y_F = 0 they differ: the new coupling terms are seen
+    np.testing.assert_array_less(1e-4, np.max(np.abs(np.array(
+        OSV.natural_periods(control=False, euler=[0.0, 0.0, 0.0])) - want) / np.array(want)))
+
+
+@pytest.mark.parametrize("method,order,hs", [("sp2", 2, [0.5, 0.25, 0.125, 0.0625]), ("sp4", 4, [2.0, 1.0, 0.5, 0.25])])
+def test_an_asymmetric_hull_against_fossens_equations(method, order, hs):
+    """The OSV with its centre of flotation 1.5 m to port: orders against Fossen's equations (its
+    restoring written from the potential V = c/2 (z + r_F . q3)^2 + q3^T G q3/2), and the ledger
+    closes (the coupling is conservative)."""
+    v = asymmetric_osv()
+    init = y0_osv()
+    t_end = 16.0
+    ref = fossen.solve(v.to_dict(), fossen.initial(**init), t_end, rtol=1e-13)
+    nu_ref, q_ref, x_ref = ref[0:6], ref[6:15].reshape(3, 3, order="F"), ref[15:18]
+    y0 = v.initial_state(**init)
+    errs = []
+    for h in hs:
+        s = phsplit.simulate(v, (0.0, t_end), h, method, control_start=0.0, initial=y0)
+        assert s.status == "completed"
+        assert s.ledger.relative_residual().max() < 1e-10
+        nu = np.concatenate([s.v[-1], s.w[-1]])
+        errs.append(max(np.linalg.norm(nu - nu_ref) / np.linalg.norm(nu_ref),
+                        np.linalg.norm(s.Q[-1] - q_ref) / np.sqrt(3),
+                        np.linalg.norm(s.x[-1] - x_ref) / np.linalg.norm(x_ref)))
+    slope = np.polyfit(np.log(hs), np.log(errs), 1)[0]
+    assert abs(slope - order) < 0.2, (slope, errs)
+
+
 def y0_osv():
     return dict(euler=[0.04, -0.015, 0.25], position=[12.0, -6.0, 0.3], velocity=[1.2, -0.6, 0.1],
                 angular_velocity=[0.01, -0.004, 0.015])

@@ -1057,58 +1057,73 @@ mod tests {
     /// The restoring with the heave spring at the centre of flotation (the OSV's `x_F = −0.5 m`):
     /// the initial state is on the invariant `mu = G q3 − k z e1`, the projection brings a state
     /// that left it back (the attitude turned, `mu` and `z` kept) and leaves `H` as it was.
+    /// The OSV, and the OSV with its centre of flotation also 1.5 m off the centreline (a hull
+    /// that is not port–starboard symmetric).
+    fn flotation_vessels() -> Vec<Vessel> {
+        let osv = Vessel::preset("osv").unwrap();
+        let mut t = osv.params.clone();
+        t["vessel"]
+            .as_table_mut()
+            .unwrap()
+            .insert("flotation_center_y".into(), toml::Value::Float(1.5));
+        vec![osv, Vessel::from_table(t).unwrap()]
+    }
+
     #[test]
     fn the_flotation_centre_keeps_its_invariant_and_projection() {
-        let v = Vessel::preset("osv").unwrap();
-        let r = v.force("restoring").unwrap();
-        let sys = VesselSystem::new(&v, Some(0.0));
-        let mut s = v.state_from(
-            Vector3::new(0.04, -0.03, 0.2),
-            Vector3::new(3.0, -2.0, 0.4),
-            Vector3::zeros(),
-            Vector3::zeros(),
-        );
-        // mu from its definition, written out: G' = mv g diag(GM_L, GM_T, 0) + diag(x_F² c, 0, 0),
-        // k = −x_F c.
-        let (m, gr) = (scalar(&v, "mass"), scalar(&v, "gravity"));
-        let c = gr * scalar(&v, "water_density") * scalar(&v, "waterplane_area");
-        let xf = scalar(&v, "flotation_center_x");
-        let g1 = m * gr * scalar(&v, "gm_longitudinal") + xf * xf * c;
-        let g2 = m * gr * scalar(&v, "gm_transverse");
-        let want = |s: &VesselState| {
+        for v in flotation_vessels() {
+            let r = v.force("restoring").unwrap();
+            let sys = VesselSystem::new(&v, Some(0.0));
+            let mut s = v.state_from(
+                Vector3::new(0.04, -0.03, 0.2),
+                Vector3::new(3.0, -2.0, 0.4),
+                Vector3::zeros(),
+                Vector3::zeros(),
+            );
+            // mu from its definition, written out: G' = mv g diag(GM_L, GM_T, 0) + c r_F r_Fᵀ,
+            // mu = G' q3 + z c r_F, r_F = (x_F, y_F, 0).
+            let (m, gr) = (scalar(&v, "mass"), scalar(&v, "gravity"));
+            let c = gr * scalar(&v, "water_density") * scalar(&v, "waterplane_area");
+            let xf = scalar(&v, "flotation_center_x");
+            let yf = v.params["vessel"]
+                .get("flotation_center_y")
+                .map_or(0.0, |x| x.as_float().unwrap());
+            let (gl, gt) = (
+                m * gr * scalar(&v, "gm_longitudinal"),
+                m * gr * scalar(&v, "gm_transverse"),
+            );
+            let want = |s: &VesselState| {
+                let q3 = s.q.transpose() * Vector3::z();
+                let zf = s.x.z + xf * q3.x + yf * q3.y;
+                Vector3::new(gl * q3.x + c * xf * zf, gt * q3.y + c * yf * zf, 0.0)
+            };
+            assert!((s.mu - want(&s)).norm() <= 1e-12 * s.mu.norm());
+            // Flow S1 turns Q without mu: off the invariant; the projection restores it.
+            sys.flow_s1(&mut s, 2.0, MagnusOrder::Four);
+            s.m += Vector3::new(1e7, -2e7, 3e7);
+            sys.flow_s1(&mut s, 3.0, MagnusOrder::Four);
+            let off = (s.mu - want(&s)).norm() / s.mu.norm();
+            assert!(off > 1e-6, "{off}");
+            let h0 = v.energy(&s);
+            r.project(&mut s);
+            assert!(
+                (s.mu - want(&s)).norm() <= 1e-12 * s.mu.norm(),
+                "{}",
+                (s.mu - want(&s)).norm()
+            );
+            assert_eq!(v.energy(&s), h0);
+            // The store at rest tilted: V = ½ c z_F² + ½ q3ᵀ G q3 on the invariant (with the
+            // paper's G = mv g diag(GM_L, GM_T, 0) and z_F = z + x_F q3_x + y_F q3_y, the height
+            // of the centre of flotation).
             let q3 = s.q.transpose() * Vector3::z();
-            Vector3::new(g1 * q3.x + xf * c * s.x.z, g2 * q3.y, 0.0)
-        };
-        assert!((s.mu - want(&s)).norm() <= 1e-12 * s.mu.norm());
-        // Flow S1 turns Q without mu: off the invariant; the projection restores it.
-        sys.flow_s1(&mut s, 2.0, MagnusOrder::Four);
-        s.m += Vector3::new(1e7, -2e7, 3e7);
-        sys.flow_s1(&mut s, 3.0, MagnusOrder::Four);
-        let off = (s.mu - want(&s)).norm() / s.mu.norm();
-        assert!(off > 1e-6, "{off}");
-        let h0 = v.energy(&s);
-        r.project(&mut s);
-        assert!(
-            (s.mu - want(&s)).norm() <= 1e-12 * s.mu.norm(),
-            "{}",
-            (s.mu - want(&s)).norm()
-        );
-        assert_eq!(v.energy(&s), h0);
-        // The store at rest tilted: V = ½ c z_F² + ½ q3ᵀ G q3 on the invariant (with the paper's
-        // G = mv g diag(GM_L, GM_T, 0) and z_F = z + x_F q3_x).
-        let q3 = s.q.transpose() * Vector3::z();
-        let zf = s.x.z + xf * q3.x;
-        let v_pot = 0.5 * c * zf * zf
-            + 0.5
-                * m
-                * gr
-                * (scalar(&v, "gm_longitudinal") * q3.x * q3.x
-                    + scalar(&v, "gm_transverse") * q3.y * q3.y);
-        assert!(
-            (r.storage(&s) - v_pot).abs() <= 1e-12 * v_pot,
-            "{} vs {v_pot}",
-            r.storage(&s)
-        );
+            let zf = s.x.z + xf * q3.x + yf * q3.y;
+            let v_pot = 0.5 * c * zf * zf + 0.5 * (gl * q3.x * q3.x + gt * q3.y * q3.y);
+            assert!(
+                (r.storage(&s) - v_pot).abs() <= 1e-12 * v_pot,
+                "{} vs {v_pot}",
+                r.storage(&s)
+            );
+        }
     }
 
     /// A partial rebuild (the FMU's inputs) gives the vessel a whole rebuild of the same file
