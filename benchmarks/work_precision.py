@@ -441,7 +441,13 @@ def main() -> int:
         dop = best.get(("compiled DOP853", "-", "core"), math.inf)
         L += [f"### Issue 17's targets at final error 1e-6 on [0, {T:g}] s", "",
               "Ratios of times to the same final error, core against core, measured in the same run "
-              "(the issue asks ≥ 1×, with 3× as the goal beyond it).", "",
+              "(the issue asks ≥ 1×, with 3× as the goal beyond it).", ""]
+        if T > 1000:
+            L += ["By the end of this run the vessel has settled: the final error measures whether a method "
+                  "ends on the true equilibrium. Runge–Kutta methods do at any stable step, and so do the "
+                  "splitting methods with the projection (docs/model.md §3.6); without it they end with a "
+                  "false tilt. The transient's accuracy is what [0, 100] s measures.", ""]
+        L += [
               "| fastest passive splitting against | ratio | ≥ 1× | ≥ 3× |", "|---|---|---|---|",
               f"| phsplit RK4 | {rk4 / split:.2f}× | {'yes' if rk4 / split >= 1 else 'no'} | "
               f"{'yes' if rk4 / split >= 3 else 'no'} |",
