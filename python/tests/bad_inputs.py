@@ -379,6 +379,12 @@ CATALOGUE += [
 CATALOGUE += [
     Bad("centre of flotation far off the hull", vessel_with("gravity = 9.81", "gravity = 9.81\nflotation_center_x = 5000.0"),
         E, ("vessel.flotation_center_x", "±1000 m")),
+    Bad("restoring matrix singular to working precision",
+        lambda: phsplit.Vessel.from_toml_str(
+            PAPER.replace("gravity = 9.81", "gravity = 9.81\nflotation_center_x = 1.0\nflotation_center_y = 1.0", 1)
+            .replace("gm_transverse = 2.1440", "gm_transverse = 1e-30", 1)
+            .replace("gm_longitudinal = 103.628", "gm_longitudinal = 1e-30", 1)),
+        E, ("singular to working precision", "gm_transverse")),
     Bad("centre of flotation far off the centreline",
         vessel_with("gravity = 9.81", "gravity = 9.81\nflotation_center_y = -2500.0"),
         E, ("vessel.flotation_center_y", "±1000 m")),

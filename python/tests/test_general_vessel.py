@@ -378,3 +378,18 @@ def test_a_conservative_run_has_a_small_relative_residual():
                          dissipated=s.ledger.dissipated, by_account=s.ledger.by_account,
                          kinds=s.ledger.kinds, level=s.ledger.level)
     assert bad.relative_residual()[1:].min() > 1e-6  # 1e-9 of H shows as 5e-6
+
+
+def test_the_osv_in_weather_keeps_every_account():
+    """The OSV with the shipped dp-weather scenario's waves, wind and current: nine ledger
+    accounts (there were at most eight, and such a vessel panicked), all booked, the ledger
+    closed."""
+    weather = phsplit.scenario.load("dp-weather").vessel.to_dict()
+    d = OSV.to_dict()
+    d.update({k: weather[k] for k in ("waves", "wind", "current")})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", phsplit.StepSizeWarning)
+        s = phsplit.simulate(phsplit.Vessel.from_dict(d), (0.0, 60.0), 0.5, "sp2", control_start=0.0)
+    assert s.status == "completed"
+    assert len(s.ledger.by_account) == 9
+    assert s.ledger.relative_residual().max() < 1e-10

@@ -80,6 +80,7 @@ pub fn run_splitting_watched<M: SplitModel>(
                 && model.same_field(t, t1)
                 && !model.projects()
                 && model.probe_names().is_empty()
+                && model.merges_exactly(flow)
             {
                 pending = Some((flow, len, t, start));
                 continue;

@@ -7,7 +7,7 @@
 use nalgebra::SVector;
 
 /// Most ledger accounts a model may declare.
-pub const MAX_ACCOUNTS: usize = 8;
+pub const MAX_ACCOUNTS: usize = 12;
 
 /// Whether an account books energy that flowed in through a port or energy dissipated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -104,6 +104,14 @@ pub use crate::methods::Flow;
 
 /// A model split into a conservative flow S1 and a dissipative flow S2, each with a flow map.
 pub trait SplitModel: Model {
+    /// Whether two consecutive sub-steps of `flow` equal one sub-step of their summed length
+    /// (an exact flow; a collocation is not): only then may the kernel merge the last sub-step
+    /// of a step with the first of the next, so that what a run computes does not depend on
+    /// which states it saves.
+    fn merges_exactly(&self, _flow: Flow) -> bool {
+        true
+    }
+
     /// Check that the model can provide sub-flows of order `order` (paper Remark 2.3); the
     /// kernel asks this once, before the first step.
     fn supports_order(&self, order: usize) -> crate::Result<()>;

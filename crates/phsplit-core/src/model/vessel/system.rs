@@ -534,6 +534,15 @@ impl Model for VesselSystem<'_> {
 }
 
 impl SplitModel for VesselSystem<'_> {
+    /// Flow S1 is exact for a mass matrix of the paper's form (the free rigid body's elliptic
+    /// flow), not for Kirchhoff's collocation; flow S2 is exact when it is the matrix
+    /// exponential (no forcing, `linear_flow = "exact"`), not when it is collocated.
+    fn merges_exactly(&self, flow: Flow) -> bool {
+        match flow {
+            Flow::S1 => self.vessel.body.kirchhoff.is_none(),
+            Flow::S2 => !self.forced && self.linear == LinearFlow::Exact,
+        }
+    }
     fn supports_order(&self, order: usize) -> Result<()> {
         if order > MAX_SUBFLOW_ORDER {
             return Err(Error::InvalidInput(format!(

@@ -67,12 +67,22 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
     let c = gravity * rho * awp;
     let g =
         Matrix3::from_diagonal(&Vector3::new(w * gm_l, w * gm_t, 0.0)) + rf * rf.transpose() * c;
-    let block = g.fixed_view::<2, 2>(0, 0).into_owned();
-    let inv = block
-        .try_inverse()
-        .expect("positive metacentric heights give a positive definite roll–pitch block");
+    // The inverse of the roll–pitch block [[a, b], [b, d]] (positive definite for positive
+    // metacentric heights), written out so that a diagonal block gives exactly 1/a and 1/d.
+    let (a, b, d) = (g[(0, 0)], g[(0, 1)], g[(1, 1)]);
+    let det = a * d - b * b;
+    if !(a > 0.0 && d > 0.0 && det > 0.0 && (d / det).is_finite() && (a / det).is_finite()) {
+        return Err(crate::error::Error::InvalidInput(format!(
+            "vessel.gm_longitudinal, gm_transverse and flotation_center_x, flotation_center_y give a roll–pitch restoring matrix that is singular to working precision (G'11 = {a:e}, G'12 = {b:e}, G'22 = {d:e} N m); give metacentric heights of a floating hull (centimetres to hundreds of metres)"
+        )));
+    }
     let mut g_plus = Matrix3::zeros();
-    g_plus.fixed_view_mut::<2, 2>(0, 0).copy_from(&inv);
+    if b == 0.0 {
+        (g_plus[(0, 0)], g_plus[(1, 1)]) = (1.0 / a, 1.0 / d);
+    } else {
+        (g_plus[(0, 0)], g_plus[(1, 1)]) = (d / det, a / det);
+        (g_plus[(0, 1)], g_plus[(1, 0)]) = (-b / det, -b / det);
+    }
     let coupling = rf * c;
     Ok(Some(Arc::new(Restoring {
         g,
@@ -123,7 +133,9 @@ impl Force for Restoring {
         }
     }
     fn storage(&self, s: &VesselState) -> f64 {
-        0.5 * s.mu.dot(&(self.g_plus * s.mu)) + 0.5 * self.heave_store * s.x.z * s.x.z
+        let (gp, mu) = (&self.g_plus, &s.mu);
+        let quad = mu.component_mul(mu).dot(&gp.diagonal()) + 2.0 * mu.x * mu.y * gp[(0, 1)];
+        0.5 * quad + 0.5 * self.heave_store * s.x.z * s.x.z
     }
     fn init_state(&self, s: &mut VesselState) {
         s.mu = self.g * (s.q.transpose() * Vector3::z()) + self.coupling * s.x.z;
@@ -141,8 +153,13 @@ impl Force for Restoring {
             return;
         }
         let q3 = s.q.transpose() * Vector3::z();
-        let txy = self.g_plus * (s.mu - self.coupling * s.x.z);
-        let (t0, t1) = (txy.x, txy.y);
+        let r = s.mu - self.coupling * s.x.z;
+        let (t0, t1) = if self.g[(0, 1)] == 0.0 {
+            (r.x / self.g[(0, 0)], r.y / self.g[(1, 1)])
+        } else {
+            let txy = self.g_plus * r;
+            (txy.x, txy.y)
+        };
         let r2 = t0 * t0 + t1 * t1;
         if !(r2 < 1.0) {
             return;
