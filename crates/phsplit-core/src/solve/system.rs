@@ -7,7 +7,7 @@
 use nalgebra::SVector;
 
 /// Most ledger accounts a model may declare.
-pub const MAX_ACCOUNTS: usize = 12;
+pub const MAX_ACCOUNTS: usize = 8;
 
 /// Whether an account books energy that flowed in through a port or energy dissipated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
