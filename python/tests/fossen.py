@@ -130,3 +130,26 @@ def solve(params: dict, y0: np.ndarray, t_end: float, rtol: float = 1e-12) -> np
                     t_eval=[t_end])
     assert sol.success, sol.message
     return sol.y[:, -1]
+
+
+def errors_against(vessel, init: dict, method: str, hs, t_end: float = 16.0, check=None):
+    """Relative end errors of phsplit's `method` at the steps `hs` against this model (DOP853 at
+    rtol 1e-13), controller on from t = 0: the largest of the body velocities', the attitude's
+    and the position's. `check(solution)` is called on each run."""
+    import phsplit
+
+    ref = solve(vessel.to_dict(), initial(**init), t_end, rtol=1e-13)
+    nu_ref, q_ref, x_ref = ref[0:6], ref[6:15].reshape(3, 3, order="F"), ref[15:18]
+    y0 = vessel.initial_state(**init)
+    errs = []
+    for h in hs:
+        s = phsplit.simulate(vessel, (0.0, t_end), h, method, control_start=0.0, initial=y0,
+                             ledger=check is not None)
+        assert s.status == "completed", s.failure
+        if check is not None:
+            check(s)
+        nu = np.concatenate([s.v[-1], s.w[-1]])
+        errs.append(max(np.linalg.norm(nu - nu_ref) / np.linalg.norm(nu_ref),
+                        np.linalg.norm(s.Q[-1] - q_ref) / np.sqrt(3),
+                        np.linalg.norm(s.x[-1] - x_ref) / np.linalg.norm(x_ref)))
+    return np.array(errs)

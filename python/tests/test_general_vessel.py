@@ -143,21 +143,10 @@ def test_an_asymmetric_hull_against_fossens_equations(method, order, hs):
     """The OSV with its centre of flotation 1.5 m to port: orders against Fossen's equations (its
     restoring written from the potential V = c/2 (z + r_F . q3)^2 + q3^T G q3/2), and the ledger
     closes (the coupling is conservative)."""
-    v = asymmetric_osv()
-    init = y0_osv()
-    t_end = 16.0
-    ref = fossen.solve(v.to_dict(), fossen.initial(**init), t_end, rtol=1e-13)
-    nu_ref, q_ref, x_ref = ref[0:6], ref[6:15].reshape(3, 3, order="F"), ref[15:18]
-    y0 = v.initial_state(**init)
-    errs = []
-    for h in hs:
-        s = phsplit.simulate(v, (0.0, t_end), h, method, control_start=0.0, initial=y0)
-        assert s.status == "completed"
+    def closes(s):
         assert s.ledger.relative_residual().max() < 1e-10
-        nu = np.concatenate([s.v[-1], s.w[-1]])
-        errs.append(max(np.linalg.norm(nu - nu_ref) / np.linalg.norm(nu_ref),
-                        np.linalg.norm(s.Q[-1] - q_ref) / np.sqrt(3),
-                        np.linalg.norm(s.x[-1] - x_ref) / np.linalg.norm(x_ref)))
+
+    errs = fossen.errors_against(asymmetric_osv(), y0_osv(), method, hs, check=closes)
     slope = np.polyfit(np.log(hs), np.log(errs), 1)[0]
     assert abs(slope - order) < 0.2, (slope, errs)
 
@@ -176,21 +165,7 @@ def test_orders_and_agreement_against_fossens_equations(method, order, hs):
     """SP2/SP4/SP6 on the OSV (full added mass, CG off the origin, cross-flow drag), controller on,
     against Fossen's M nu' + C(nu) nu + D nu + g = tau in numpy by DOP853: fitted orders, and the
     finest step's agreement."""
-    init = y0_osv()
-    t_end = 16.0
-    ref = fossen.solve(OSV.to_dict(), fossen.initial(**init), t_end, rtol=1e-13)
-    nu_ref, q_ref, x_ref = ref[0:6], ref[6:15].reshape(3, 3, order="F"), ref[15:18]
-    y0 = OSV.initial_state(**init)
-    errs = []
-    for h in hs:
-        s = phsplit.simulate(OSV, (0.0, t_end), h, method, control_start=0.0, initial=y0, ledger=False)
-        assert s.status == "completed"
-        nu = np.concatenate([s.v[-1], s.w[-1]])
-        e = max(np.linalg.norm(nu - nu_ref) / np.linalg.norm(nu_ref),
-                np.linalg.norm(s.Q[-1] - q_ref) / np.sqrt(3),
-                np.linalg.norm(s.x[-1] - x_ref) / np.linalg.norm(x_ref))
-        errs.append(e)
-    errs = np.array(errs)
+    errs = fossen.errors_against(OSV, y0_osv(), method, hs)
     slope = np.polyfit(np.log(hs), np.log(errs), 1)[0]
     assert abs(slope - order) < 0.2, (slope, errs)
     assert errs[-1] < {2: 1e-4, 4: 1e-6, 6: 1e-8}[order], errs

@@ -108,18 +108,7 @@ def test_orders_against_fossens_equations(method, order, hs):
     restoring coupling), controller on, against Fossen's equations in numpy by DOP853."""
     init = dict(euler=[0.04, -0.015, 0.25], position=[770.0, 12.0, 0.2], velocity=[0.8, -0.4, 0.05],
                 angular_velocity=[0.01, -0.004, 0.012])
-    t_end = 16.0
-    ref = fossen.solve(SUPPLY.to_dict(), fossen.initial(**init), t_end, rtol=1e-13)
-    nu_ref, q_ref, x_ref = ref[0:6], ref[6:15].reshape(3, 3, order="F"), ref[15:18]
-    y0 = SUPPLY.initial_state(**init)
-    errs = []
-    for h in hs:
-        s = phsplit.simulate(SUPPLY, (0.0, t_end), h, method, control_start=0.0, initial=y0, ledger=False)
-        assert s.status == "completed"
-        nu = np.concatenate([s.v[-1], s.w[-1]])
-        errs.append(max(np.linalg.norm(nu - nu_ref) / np.linalg.norm(nu_ref),
-                        np.linalg.norm(s.Q[-1] - q_ref) / np.sqrt(3),
-                        np.linalg.norm(s.x[-1] - x_ref) / np.linalg.norm(x_ref)))
+    errs = fossen.errors_against(SUPPLY, init, method, hs)
     slope = np.polyfit(np.log(hs), np.log(errs), 1)[0]
     assert abs(slope - order) < 0.2, (slope, errs)
 
