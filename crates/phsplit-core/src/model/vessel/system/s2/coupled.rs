@@ -1,7 +1,8 @@
 //! Flow S2 as one coupled 18-dimensional system, where the mass matrix or a force couples
 //! translation and rotation (docs/model.md §5.14): its exact flow with the ledger by the Van
-//! Loan Gramian, and its Gauss collocation with the forcing iterated (the fixed point and the
-//! balancing are the block systems', `s2.rs`).
+//! Loan Gramian; and the Gauss collocation of S2 with a forcing part, coupled or not, by the
+//! structured stage solver in blocks of six with the forcing iterated (the fixed point and the
+//! balancing are `s2.rs`'s).
 
 // Stage loops index the Butcher tableau `a_ij`, `b_i` and the blocks as the formulas write them.
 #![allow(clippy::needless_range_loop)]
