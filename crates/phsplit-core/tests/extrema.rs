@@ -1,8 +1,33 @@
 //! Issue 14: summaries from every step. The running maxima of the controller's force and moment
 //! must equal the maxima over every step's state, also when only every 50th state is saved.
-use phsplit_core::model::vessel::{Vessel, VesselSystem};
+use phsplit_core::model::vessel::{Vessel, VesselState, VesselSystem};
 use phsplit_core::settings::Settings;
-use phsplit_core::solve::{run, Model};
+use phsplit_core::solve::{run, Model, Trajectory};
+
+/// The paper's vessel by `sys` with `method` at step `h` on `[0, t1]`, the controller from
+/// `control`, saving every `save_every`-th state.
+fn run_paper(
+    sys: &VesselSystem,
+    method: &str,
+    (t1, h, control): (f64, f64, f64),
+    save_every: usize,
+) -> Trajectory<VesselState> {
+    let s = Settings {
+        t_span: (0.0, t1),
+        h,
+        method: method.parse().unwrap(),
+        control_start: Some(control),
+        save_every,
+        ..Settings::default()
+    };
+    run(
+        sys,
+        &s.method,
+        Vessel::paper().initial_state(),
+        &s.options().unwrap(),
+    )
+    .unwrap()
+}
 
 #[test]
 fn running_maxima_cover_every_step_whatever_is_saved() {
@@ -12,15 +37,7 @@ fn running_maxima_cover_every_step_whatever_is_saved() {
             let sys = VesselSystem::new(&v, Some(10.0))
                 .with_extrema(true)
                 .with_projection(project);
-            let s = Settings {
-                t_span: (0.0, 100.0),
-                h: 0.25,
-                method: method.parse().unwrap(),
-                control_start: Some(10.0),
-                save_every,
-                ..Settings::default()
-            };
-            let tr = run(&sys, &s.method, v.initial_state(), &s.options().unwrap()).unwrap();
+            let tr = run_paper(&sys, method, (100.0, 0.25, 10.0), save_every);
             (sys, tr)
         };
         let (sys, all) = every(1);
@@ -74,15 +91,7 @@ fn running_maxima_do_not_merge_sub_steps_away() {
             let sys = VesselSystem::new(&v, Some(0.0))
                 .with_extrema(true)
                 .with_projection(false);
-            let s = Settings {
-                t_span: (0.0, 100.0),
-                h: 0.25,
-                method: method.parse().unwrap(),
-                control_start: Some(0.0),
-                save_every,
-                ..Settings::default()
-            };
-            run(&sys, &s.method, v.initial_state(), &s.options().unwrap()).unwrap()
+            run_paper(&sys, method, (100.0, 0.25, 0.0), save_every)
         };
         let (all, some) = (every(1), every(50));
         assert_eq!(some.states.last(), all.states.last(), "{method}");
@@ -103,15 +112,7 @@ fn a_run_does_not_depend_on_what_it_saves() {
             let sys = VesselSystem::new(&v, Some(0.0))
                 .with_projection(false)
                 .with_linear_flow(lf);
-            let s = Settings {
-                t_span: (0.0, 70.0),
-                h: 0.5,
-                method: "sp2".parse().unwrap(),
-                control_start: Some(0.0),
-                save_every,
-                ..Settings::default()
-            };
-            run(&sys, &s.method, v.initial_state(), &s.options().unwrap()).unwrap()
+            run_paper(&sys, "sp2", (70.0, 0.5, 0.0), save_every)
         };
         let (all, some) = (every(1), every(7));
         let (a, b) = (all.states.last().unwrap(), some.states.last().unwrap());
