@@ -471,6 +471,44 @@ impl<'a> VesselSystem<'a> {
     }
 }
 
+/// The accounts whose forces make up the controller's force in the probe ([`Model::probe`]):
+/// its P, I and D parts, or what its thrusters deliver.
+const CONTROL_ACCOUNTS: [&str; 3] = ["control", "control_damping", "thrusters"];
+
+impl VesselSystem<'_> {
+    /// The controller's force and moment (body frame, about the body origin) at `s` on a step
+    /// that starts at `t`: the sum of [`Self::account_wrenches`] over [`CONTROL_ACCOUNTS`],
+    /// assembled from the components that book to them only (the probe runs after every step).
+    fn control_wrench(&self, s: &VesselState, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let fr = self.frozen(s, self.control_on(t));
+        let z = self.blocks_of(s);
+        let mut b = S2Builder::new(Some(self.accounts.len()));
+        let mut g = Forcing::new();
+        for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
+            if f.accounts()
+                .iter()
+                .any(|a| CONTROL_ACCOUNTS.contains(&a.name))
+            {
+                b.base = base;
+                f.add_s2(&fr, &mut b);
+                if f.forced() {
+                    g.base = base;
+                    f.add_forcing(&fr, t, &z, &mut g);
+                }
+            }
+        }
+        let booked = b.booked.expect("built with the ledger");
+        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+        for (k, a) in self.accounts.iter().enumerate() {
+            if CONTROL_ACCOUNTS.contains(&a.name) {
+                force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked[k][0];
+                moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked[k][1];
+            }
+        }
+        (force, moment)
+    }
+}
+
 // ------------------------------------------------------------------------------------------
 // The vessel for the solver.
 
@@ -514,14 +552,7 @@ impl Model for VesselSystem<'_> {
     /// The norms of the controller's force and moment (its P, I and D accounts together, or what
     /// its thrusters deliver).
     fn probe(&self, t: f64, s: &VesselState, out: &mut [f64]) {
-        let w = self.account_wrenches(s, t, self.control_on(t));
-        let (mut f, mut m) = (Vector3::zeros(), Vector3::zeros());
-        for (a, (fa, ma)) in self.accounts.iter().zip(&w) {
-            if matches!(a.name, "control" | "control_damping" | "thrusters") {
-                f += fa;
-                m += ma;
-            }
-        }
+        let (f, m) = self.control_wrench(s, t);
         out[0] = f.norm();
         out[1] = m.norm();
     }
@@ -670,6 +701,51 @@ mod tests {
             super::super::PAPER_VESSEL_TOML
         );
         Vessel::from_toml_str(&text).unwrap()
+    }
+
+    /// The probe's controller wrench is the sum of the controller's accounts in
+    /// `account_wrenches` (every component assembled), for the paper's controller and for the
+    /// pipe-lay vessel, whose controller delivers through thrusters beside a pipe.
+    #[test]
+    fn the_probe_is_the_wrench_of_the_controllers_accounts() {
+        let scenario: toml::Table =
+            include_str!("../../../../../python/src/phsplit/scenarios/pipelay.toml")
+                .parse()
+                .unwrap();
+        let mut table: toml::Table = include_str!("../../../data/paper_vessel.toml")
+            .parse()
+            .unwrap();
+        for k in ["setpoint", "pipe", "thrusters"] {
+            table.insert(k.into(), scenario[k].clone());
+        }
+        let pipelay = Vessel::from_table(table).unwrap();
+        for v in [Vessel::paper(), pipelay] {
+            let sys = VesselSystem::new(&v, Some(5.0));
+            let mut s = v.initial_state();
+            for (i, t) in [0.0, 7.0, 700.0, 1800.0].into_iter().enumerate() {
+                let k = i as f64 + 1.0;
+                s.p += Vector3::new(1e5, -2e5, 3e4) * k;
+                s.m += Vector3::new(-1e6, 2e6, 5e6) * k;
+                s.x += Vector3::new(3.0, -2.0, 0.1) * k;
+                s.phi_x += Vector3::new(10.0, 5.0, -1.0);
+                s.phi_th += Vector3::new(0.1, -0.1, 0.2);
+                let (f, m) = sys.control_wrench(&s, t);
+                let w = sys.account_wrenches(&s, t, sys.control_on(t));
+                let (mut fw, mut mw) = (Vector3::zeros(), Vector3::zeros());
+                let mut n = 0;
+                for (a, (fa, ma)) in sys.accounts().iter().zip(&w) {
+                    if CONTROL_ACCOUNTS.contains(&a.name) {
+                        fw += fa;
+                        mw += ma;
+                        n += 1;
+                    }
+                }
+                assert!(n >= 1);
+                assert!(t < 5.0 || fw.norm() > 0.0, "the controller acts at {t}");
+                assert!((f - fw).norm() <= 1e-12 * fw.norm().max(1.0), "{f} vs {fw}");
+                assert!((m - mw).norm() <= 1e-12 * mw.norm().max(1.0), "{m} vs {mw}");
+            }
+        }
     }
 
     #[test]
