@@ -69,6 +69,14 @@ def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
     with phsplit.open_dataset(store / "summary.nc") as s:
         status = list(s["status"].values)
     assert status.count("invalid") == 3 and status.count("completed") == 6
+    # the summary written from the results in memory is the one the case files give back
+    written = (store / "summary.csv").read_text()
+    from phsplit.batch import write_summary
+    write_summary(str(store), [sw.case_id(i) for i in range(9)])
+    assert (store / "summary.csv").read_text() == written and written.count("\n") == 10
+    import netCDF4
+    with netCDF4.Dataset(store / "cases" / f"{sw.case_id(4)}.nc") as one:  # one chunk per variable
+        assert one["position"].chunking() == list(one["position"].shape)
     # the computed cases as one lazy dataset with a case dimension
     with phsplit.open_sweep(store) as all_cases:
         assert all_cases.sizes["case"] == 6 and all_cases["position"].chunks is not None

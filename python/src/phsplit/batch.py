@@ -321,8 +321,14 @@ def _run_case(base_tables: dict, settings: Settings, case: dict) -> dict:
             "dataset": ds}
 
 
-def _write_case(store: str, cid: str, result: dict) -> None:
-    """Write one case atomically: STORE/cases/<cid>.nc via a temporary file and a rename."""
+def _summary_row(cid: str, case: dict, summary: dict, status: str, error: str) -> dict:
+    """A case's row of the sweep's summary table."""
+    return {"case_id": cid, **case, **summary, "status": status, "error": error}
+
+
+def _write_case(store: str, cid: str, result: dict) -> dict:
+    """Write one case atomically: STORE/cases/<cid>.nc via a temporary file and a rename.
+    Returns the case's summary row (as :func:`write_summary` would read it back)."""
     import xarray as xr
 
     from .plotting import publish
@@ -340,11 +346,18 @@ def _write_case(store: str, cid: str, result: dict) -> None:
     fd, tmp = tempfile.mkstemp(dir=cases_dir, prefix=".tmp-", suffix=".nc")
     os.close(fd)
     try:
-        ds.to_netcdf(tmp)
+        # A case file is written once: each variable along the record dimension in one HDF5
+        # chunk (netCDF's default chunk of one record made writing 2.2x as slow, the file 2.1x
+        # as large).
+        ds.to_netcdf(tmp, encoding={k: {"chunksizes": ds[k].shape} for k in ds.data_vars
+                                    if "time" in ds[k].dims and ds[k].size})
         publish(tmp, os.path.join(cases_dir, f"{cid}.nc"))
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+    a = ds.attrs
+    return _summary_row(cid, json.loads(a["case_parameters"]), json.loads(a["case_summary"]),
+                        a["case_status"], a["case_error"])
 
 
 def done_cases(store: str) -> set[str]:
@@ -374,6 +387,7 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                   f, indent=1, default=repr)
     publish(tmp, os.path.join(store, "sweep.json"))  # whole or not at all
     cluster = None
+    rows: dict[str, dict] = {}  # the summary rows of the cases computed now
     t0 = time.perf_counter()
     if todo:
         if scheduler:
@@ -394,30 +408,35 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                     except Exception as e:  # noqa: BLE001 - a case's crash is recorded, not fatal
                         result = {"status": "error", "error": f"{type(e).__name__}: {e}",
                                   "case": sweep.cases[ids.index(cid)]}
-                    _write_case(store, cid, result)
+                    rows[cid] = _write_case(store, cid, result)
                     bar.update(1)
         finally:
             client.close()
             if cluster is not None:
                 cluster.close()
     elapsed = time.perf_counter() - t0
-    summary = write_summary(store, ids)
+    summary = write_summary(store, ids, rows)
     return {"cases": len(ids), "computed": len(todo), "reused": len(ids) - len(todo), "seconds": elapsed,
             "summary": summary}
 
 
-def write_summary(store: str, ids: list[str]) -> str:
-    """One row per case: parameters, summary, status and error; as CSV and NetCDF."""
+def write_summary(store: str, ids: list[str], known: dict[str, dict] | None = None) -> str:
+    """One row per case: parameters, summary, status and error; as CSV and NetCDF. The rows of
+    ``known`` (by case id, as :func:`_write_case` returns them) are used as given; the other
+    cases' rows are read from their files in the store."""
     import csv
 
     import xarray as xr
 
     rows = []
     for cid in ids:
+        if known and cid in known:
+            rows.append(known[cid])
+            continue
         with xr.open_dataset(os.path.join(store, "cases", f"{cid}.nc")) as ds:
             a = ds.attrs
-            rows.append({"case_id": cid, **json.loads(a["case_parameters"]), **json.loads(a["case_summary"]),
-                         "status": a["case_status"], "error": a["case_error"]})
+            rows.append(_summary_row(cid, json.loads(a["case_parameters"]), json.loads(a["case_summary"]),
+                                     a["case_status"], a["case_error"]))
     cols = list(dict.fromkeys(k for r in rows for k in r))
     path = os.path.join(store, "summary.csv")
     with open(path, "w", newline="") as f:
