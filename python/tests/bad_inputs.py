@@ -398,3 +398,25 @@ CATALOGUE += [
             [_ROW] + ["[0.0, -6.3622084999999e6, 0.0, 0.0, 0.0, 0.0]"] + [_ROW] * 4) + "]"), E,
         ("nearly singular", "condition number")),
 ]
+
+# issue 12: rate-limited thrusters
+_RATED = ("[thrusters]\nhull_length = 83.0\nhull_beam = 18.0\n"
+          "[[thrusters.unit]]\nkind = \"tunnel\"\nposition = [37.0, 0.0, -3.0]\nmax_thrust = 3e5\n{tunnel}"
+          "[[thrusters.unit]]\nkind = \"azimuth\"\nposition = [-41.5, 7.0, -3.0]\nmax_thrust = 4.2e5\n{azimuth}"
+          "[[thrusters.unit]]\nkind = \"azimuth\"\nposition = [-41.5, -7.0, -3.0]\nmax_thrust = 6.55e5\n"
+          "[initial]")
+
+
+def _rated(tunnel: str = "", azimuth: str = "thrust_rate = 4.2e4\nturn_rate = 10.0\n") -> str:
+    return _RATED.format(tunnel=tunnel, azimuth=azimuth)
+
+
+CATALOGUE += [
+    Bad("negative thrust rate", vessel_with("[initial]", _rated(tunnel="thrust_rate = -3e4\n")), E,
+        ("thrusters.unit[0].thrust_rate", "> 0", "N/s")),
+    Bad("turning rate for a tunnel thruster", vessel_with("[initial]", _rated(tunnel="turn_rate = 10.0\n")), P,
+        ("turn_rate", "thrusters.unit[0]")),
+    Bad("rate-limited thrusters with a Runge-Kutta method",
+        lambda: phsplit.simulate(vessel_with("[initial]", _rated())(), (0.0, 5.0), 0.5, "rk4", control_start=0.0), E,
+        ("rate-limited thrusters", "splitting method")),
+]

@@ -154,7 +154,8 @@ impl PyVessel {
         t: f64,
         control_start: Option<f64>,
     ) -> PyResult<std::collections::BTreeMap<String, f64>> {
-        let s = VesselState::from_slice_continuing(&entries(&state)).map_err(to_py)?;
+        let s = VesselState::from_slice_continuing(&entries(&state), self.inner.actuators())
+            .map_err(to_py)?;
         let sys = VesselSystem::new(&self.inner, control_start);
         Ok(sys
             .outputs(&s, t)
@@ -288,8 +289,14 @@ fn check_state<'py>(
     state: PyReadonlyArray1<'py, f64>,
     orthonormalize: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let s = VesselState::from_slice_checked(&entries(&state), orthonormalize).map_err(to_py)?;
-    Ok(PyArray1::from_slice(py, s.to_vector().as_slice()))
+    // The 27 numbers are checked here; a tail (the memory of rate-limited thrusters, as
+    // `Solution.state(i)` gives it) is kept as it is, for the run to check against its vessel.
+    let y = entries(&state);
+    let (head, tail) = y.split_at(y.len().min(STATE_DIM));
+    let s = VesselState::from_slice_checked(head, orthonormalize).map_err(to_py)?;
+    let mut out = s.to_vector().as_slice().to_vec();
+    out.extend_from_slice(tail);
+    Ok(PyArray1::from_vec(py, out))
 }
 
 /// A mapping of TOML values (tables of numbers, strings, booleans, lists) as TOML text, by

@@ -67,8 +67,14 @@ fn integrate<'py>(
     let opts = settings.options().map_err(to_py)?;
     let y0 = match &state0 {
         None => vessel.inner.initial_state(),
-        Some(a) if continuing => VesselState::from_slice_continuing(&entries(a)).map_err(to_py)?,
-        Some(a) => VesselState::from_slice_checked(&entries(a), orthonormalize).map_err(to_py)?,
+        Some(a) if continuing => {
+            VesselState::from_slice_continuing(&entries(a), vessel.inner.actuators())
+                .map_err(to_py)?
+        }
+        Some(a) => {
+            VesselState::from_slice_user(&entries(a), orthonormalize, vessel.inner.actuators())
+                .map_err(to_py)?
+        }
     };
     let v = vessel.inner.clone();
     let s2 = settings.clone();
@@ -196,10 +202,25 @@ fn integrate<'py>(
     }
     d.set_item("outputs", reported)?;
     d.set_item("steps", traj.steps)?;
+    // A state that continues the run: the 27 numbers, then the memory of rate-limited
+    // thrusters (none for other vessels).
+    let continuing = |s: &VesselState| {
+        let mut v = s.to_vector().as_slice().to_vec();
+        v.extend(s.act.to_flat());
+        v
+    };
     d.set_item(
         "last_good",
-        PyArray1::from_slice(py, traj.last_good.to_vector().as_slice()),
+        PyArray1::from_vec(py, continuing(&traj.last_good)),
     )?;
+    let width = traj.states.first().map_or(0, |s| s.act.to_flat().len());
+    let memory: Vec<f64> = traj.states.iter().flat_map(|s| s.act.to_flat()).collect();
+    if width > 0 && memory.len() == n * width {
+        d.set_item(
+            "actuators",
+            PyArray1::from_vec(py, memory).reshape([n, width])?,
+        )?;
+    }
     d.set_item("t_last_good", traj.t_last_good)?;
     let ext = PyDict::new(py);
     for (k, name) in traj.probe_names.iter().enumerate() {

@@ -239,6 +239,9 @@ class Solution:
     #: What the components report at the saved states (the pipe's top tension, the moving set
     #: point, ...): name -> (unit, long name, values).
     outputs: dict[str, tuple[str, str, np.ndarray]] = field(default_factory=dict)
+    #: The memory of rate-limited thrusters at the saved states (time, each thruster's thrust,
+    #: each thruster's angle in rad; docs/model.md §5.8), or None for a vessel without them.
+    actuators: np.ndarray | None = None
 
     def force(self, *accounts: str) -> np.ndarray:
         """Body-frame force (N, 3) of the named ledger accounts, summed (all when none given)."""
@@ -329,9 +332,11 @@ class Solution:
 
     def state(self, i: int = -1) -> np.ndarray:
         """The flat 27-vector state at saved index ``i`` (p, m, Q column-major, mu, x, phi_th,
-        phi_x), as the core takes it."""
-        return np.concatenate([self.p[i], self.m[i], self.Q[i].reshape(-1, order="F"), self.mu[i], self.x[i],
-                               self.phi_th[i], self.phi_x[i]])
+        phi_x), as the core takes it; for a vessel with rate-limited thrusters followed by
+        their memory (:attr:`actuators`), so that a run continued from it goes on as one run."""
+        y = np.concatenate([self.p[i], self.m[i], self.Q[i].reshape(-1, order="F"), self.mu[i], self.x[i],
+                            self.phi_th[i], self.phi_x[i]])
+        return y if self.actuators is None else np.concatenate([y, self.actuators[i]])
 
     def settings_toml(self) -> str:
         """The run's settings as a ``[simulation]`` TOML table (what a scenario file takes)."""
@@ -685,9 +690,10 @@ def simulate(
               "components": vessel.components},
         account_force=raw["account_force"], account_moment=raw["account_moment"], settings=dict(used),
         outputs={k: (u, ln, np.asarray(v)) for k, (u, ln, v) in raw.get("outputs", {}).items()},
+        actuators=raw.get("actuators"),
     )
     # What reruns it (phsplit rerun): the vessel file, the initial state the core used, one chunk.
     sol.meta["running_max"] = dict(raw["running_max"])
-    sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0),
+    sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0)[:27],
                               "chunks": [int(used["n_steps"])]}
     return sol

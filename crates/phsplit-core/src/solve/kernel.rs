@@ -47,6 +47,8 @@ pub fn run_splitting_watched<M: SplitModel>(
         .collect();
     let fsal = subs.len() > 1 && subs[0].0 == subs[subs.len() - 1].0;
     let last = subs.len() - 1;
+    let mut y0 = y0;
+    model.begin(opts.t0, &mut y0);
     let mut rec = Recorder::new(model, opts.t0, y0, opts);
     let mut y = y0;
     // A last sub-step deferred into the next step: (flow, length, its step's start time, the
@@ -93,6 +95,9 @@ pub fn run_splitting_watched<M: SplitModel>(
         if model.projects() {
             rec.acc += model.project(&mut y);
         }
+        if pending.is_none() {
+            model.end_step(t, t1, &mut y);
+        }
         rec.traj.steps = n + 1;
         if pending.is_none() {
             // y sits on the step boundary (no sub-step deferred into the next step).
@@ -111,6 +116,7 @@ pub fn run_splitting_watched<M: SplitModel>(
                 if !model.is_finite(&y) {
                     return Ok(rec.fail(n, t));
                 }
+                model.end_step(t, t1, &mut y);
             }
             return Ok(rec.interrupt(n + 1, t1, y, saved));
         }
@@ -145,6 +151,9 @@ pub fn run_runge_kutta_watched<const N: usize, M: FieldModel<N>>(
     monitor: &mut dyn Monitor,
 ) -> Result<Trajectory<M::State>> {
     opts.validate()?;
+    if let Some(why) = model.runge_kutta_refused() {
+        return Err(crate::Error::InvalidInput(why));
+    }
     let s = tableau.stages();
     let mut rec = Recorder::new(model, opts.t0, y0, opts);
     let mut y = model.to_vector(&y0);

@@ -97,6 +97,19 @@ pub trait Model {
     }
     /// The probed quantities at `s`, with the field of a step that starts at `t`.
     fn probe(&self, _t: f64, _s: &Self::State, _out: &mut [f64]) {}
+    /// Prepare the state of a run that starts at `t0`: a memory the model keeps in its state
+    /// beside what the flows integrate (rate-limited actuators), started if it is not set.
+    /// Nothing by default.
+    fn begin(&self, _t0: f64, _s: &mut Self::State) {}
+    /// After every step (which started at `t_step`), on the step boundary `t1` (after the
+    /// projection): update that memory. A model that keeps one must not let sub-steps merge
+    /// across step boundaries ([`SplitModel::merges_exactly`]). Nothing by default.
+    fn end_step(&self, _t_step: f64, _t1: f64, _s: &mut Self::State) {}
+    /// Why Runge–Kutta methods cannot integrate this model, if they cannot (a memory their
+    /// kernel does not carry).
+    fn runge_kutta_refused(&self) -> Option<String> {
+        None
+    }
 }
 
 /// Which of the two flows of a split model a sub-step belongs to.

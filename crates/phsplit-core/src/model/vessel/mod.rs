@@ -23,7 +23,7 @@ pub use body::Body;
 use forces::Force;
 use nalgebra::Vector3;
 use params::{Params, Range};
-pub use state::{VesselState, LAYOUT, STATE_DIM};
+pub use state::{Actuators, VesselState, LAYOUT, MAX_ACTUATORS, STATE_DIM};
 use std::sync::Arc;
 pub use system::{LinearFlow, VesselSystem};
 
@@ -230,6 +230,7 @@ impl Vessel {
             x: position,
             phi_th: z,
             phi_x: z,
+            act: Default::default(),
         };
         for f in &self.forces {
             f.init_state(&mut s);
@@ -246,6 +247,12 @@ impl Vessel {
             i.velocity.into(),
             i.angular_velocity.into(),
         )
+    }
+
+    /// How many rate-limited thrusters the state remembers ([`VesselState::act`]; 0 without
+    /// rate limits).
+    pub fn actuators(&self) -> usize {
+        self.forces.iter().map(|f| f.actuators()).sum()
     }
 
     /// The energy `H` of eq. (35), J (without constant terms).

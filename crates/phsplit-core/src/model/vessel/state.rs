@@ -21,6 +21,68 @@ pub struct VesselState {
     pub phi_th: Vector3<f64>,
     /// `∫(x − x_ref) dt`, m s.
     pub phi_x: Vector3<f64>,
+    /// What rate-limited thrusters deliver (none for other vessels): not part of the 27-vector
+    /// the flows integrate, but a memory the run keeps from step to step.
+    pub act: Actuators,
+}
+
+/// Most thrusters a vessel with rate-limited thrusters may have (their memory is part of the
+/// state, of fixed size).
+pub const MAX_ACTUATORS: usize = 8;
+
+/// The memory of rate-limited thrusters (docs/model.md §5.8): each thruster's thrust (N) and
+/// the direction of its force (rad, in the body's x–y plane, in (−π, π]) as delivered at time
+/// `t`. The vessel's flows read it and the end of every step writes it; `n = 0` means none
+/// (a vessel without rate limits, or a run not yet started).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Actuators {
+    pub n: usize,
+    pub t: f64,
+    pub thrust: [f64; MAX_ACTUATORS],
+    pub angle: [f64; MAX_ACTUATORS],
+}
+
+impl Default for Actuators {
+    fn default() -> Self {
+        Self {
+            n: 0,
+            t: 0.0,
+            thrust: [0.0; MAX_ACTUATORS],
+            angle: [0.0; MAX_ACTUATORS],
+        }
+    }
+}
+
+impl Actuators {
+    /// The flat form that follows the 27 numbers of a state that continues a run:
+    /// `t, thrust[0..n], angle[0..n]` (`1 + 2n` numbers; none when `n = 0`).
+    pub fn to_flat(&self) -> Vec<f64> {
+        if self.n == 0 {
+            return Vec::new();
+        }
+        let mut v = vec![self.t];
+        v.extend_from_slice(&self.thrust[..self.n]);
+        v.extend_from_slice(&self.angle[..self.n]);
+        v
+    }
+
+    /// Inverse of [`Self::to_flat`] for `n` thrusters.
+    pub fn from_flat(v: &[f64], n: usize) -> Result<Self> {
+        if n == 0 || n > MAX_ACTUATORS || v.len() != 1 + 2 * n {
+            return Err(Error::InvalidInput(format!(
+                "the thrusters' memory of a state that continues a run has 1 + 2n numbers (time, each thruster's thrust, each thruster's angle) for n = {n} rate-limited thrusters, got {}",
+                v.len()
+            )));
+        }
+        let mut a = Self {
+            n,
+            t: v[0],
+            ..Self::default()
+        };
+        a.thrust[..n].copy_from_slice(&v[1..1 + n]);
+        a.angle[..n].copy_from_slice(&v[1 + n..]);
+        Ok(a)
+    }
 }
 
 /// Dimension of the state as a flat vector.
@@ -72,6 +134,7 @@ impl VesselState {
             x: v3(4),
             phi_th: v3(5),
             phi_x: v3(6),
+            act: Actuators::default(),
         }
     }
 
@@ -86,12 +149,22 @@ impl VesselState {
     /// its length and finiteness are checked. An explicit Runge–Kutta method lets `Q` drift off
     /// SO(3) by its own error, and the continuation must take the state as it is, so that a run
     /// cut into several calls gives the same numbers as one call.
-    pub fn from_slice_continuing(y: &[f64]) -> Result<Self> {
-        if y.len() != STATE_DIM {
-            return Err(Error::InvalidInput(format!(
-                "a state is a flat vector of {STATE_DIM} numbers, got {}",
-                y.len()
-            )));
+    /// A vessel with `actuators` rate-limited thrusters may follow the 27 numbers with their
+    /// memory ([`Actuators::to_flat`]); without it the run starts them afresh.
+    pub fn from_slice_continuing(y: &[f64], actuators: usize) -> Result<Self> {
+        let with_memory = STATE_DIM + 1 + 2 * actuators;
+        if y.len() != STATE_DIM && (actuators == 0 || y.len() != with_memory) {
+            return Err(Error::InvalidInput(if actuators == 0 {
+                format!(
+                    "a state is a flat vector of {STATE_DIM} numbers, got {}",
+                    y.len()
+                )
+            } else {
+                format!(
+                    "a state to continue from is a flat vector of {STATE_DIM} numbers, or {with_memory} with the memory of the {actuators} rate-limited thrusters, got {}",
+                    y.len()
+                )
+            }));
         }
         if let Some(i) = y.iter().position(|v| !v.is_finite()) {
             return Err(Error::InvalidInput(format!(
@@ -99,9 +172,38 @@ impl VesselState {
                 y[i]
             )));
         }
-        Ok(Self::from_vector(
-            &SVector::<f64, STATE_DIM>::from_column_slice(y),
-        ))
+        let mut s = Self::from_vector(&SVector::<f64, STATE_DIM>::from_column_slice(
+            &y[..STATE_DIM],
+        ));
+        if y.len() > STATE_DIM {
+            s.act = Actuators::from_flat(&y[STATE_DIM..], actuators)?;
+        }
+        Ok(s)
+    }
+
+    /// [`Self::from_slice_checked`] for a vessel with `actuators` rate-limited thrusters: the
+    /// 27 numbers may be followed by the thrusters' memory ([`Actuators::to_flat`], as
+    /// `Solution.state(i)` gives it), which must then be finite.
+    pub fn from_slice_user(y: &[f64], orthonormalize: bool, actuators: usize) -> Result<Self> {
+        if actuators == 0 || y.len() == STATE_DIM {
+            return Self::from_slice_checked(y, orthonormalize);
+        }
+        let with_memory = STATE_DIM + 1 + 2 * actuators;
+        if y.len() != with_memory {
+            return Err(Error::InvalidInput(format!(
+                "a state is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x), or {with_memory} with the memory of the vessel's {actuators} rate-limited thrusters (time, thrusts, angles), got {}",
+                y.len()
+            )));
+        }
+        let mut s = Self::from_slice_checked(&y[..STATE_DIM], orthonormalize)?;
+        if let Some(i) = y[STATE_DIM..].iter().position(|v| !v.is_finite()) {
+            return Err(Error::InvalidInput(format!(
+                "the thrusters' memory after the state must be finite; its entry {i} is {}",
+                y[STATE_DIM + i]
+            )));
+        }
+        s.act = Actuators::from_flat(&y[STATE_DIM..], actuators)?;
+        Ok(s)
     }
 
     pub fn from_slice_checked(y: &[f64], orthonormalize: bool) -> Result<Self> {

@@ -88,6 +88,8 @@ pub struct VesselSystem<'a> {
     forced_timed: bool,
     /// Why a sub-flow gave up (a [`GaveUp`] code; 0: none), for the run's failure message.
     gave_up: std::sync::Arc<std::sync::atomic::AtomicU8>,
+    /// How many rate-limited thrusters the state remembers ([`VesselState::act`]).
+    pub actuators: usize,
 }
 
 /// Why a sub-flow gave up rather than return an unconverged result.
@@ -139,6 +141,7 @@ impl<'a> VesselSystem<'a> {
                 .iter()
                 .any(|f| f.forced() && !f.forcing_uses_state()),
             gave_up: Default::default(),
+            actuators: vessel.actuators(),
         }
     }
 
@@ -233,6 +236,7 @@ impl<'a> VesselSystem<'a> {
     fn frozen(&self, s: &VesselState, on: bool) -> Frozen<'_> {
         let mut fr = self.frozen_at(&s.q, on);
         fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
+        fr.actuators = s.act;
         fr
     }
 
@@ -250,6 +254,7 @@ impl<'a> VesselSystem<'a> {
             control_on: on,
             body: &self.vessel.body,
             velocity: [Vector3::zeros(); 2],
+            actuators: Default::default(),
         }
     }
 
@@ -363,6 +368,7 @@ impl<'a> VesselSystem<'a> {
                     x: z,
                     phi_th: z,
                     phi_x: z,
+                    act: s.act,
                 }
             }
             Flow::S2 => {
@@ -392,6 +398,7 @@ impl<'a> VesselSystem<'a> {
                     x: ft[1],
                     phi_th: fr[2],
                     phi_x: ft[2],
+                    act: s.act,
                 }
             }
         }
@@ -555,6 +562,38 @@ impl Model for VesselSystem<'_> {
         let (f, m) = self.control_wrench(s, t);
         out[0] = f.norm();
         out[1] = m.norm();
+    }
+    /// Rate-limited thrusters: start their memory with what they deliver at `t0`, unless the
+    /// state brings it (a run continued from an earlier call's last state).
+    fn begin(&self, t0: f64, s: &mut VesselState) {
+        if self.actuators == 0 || s.act.n == self.actuators {
+            return;
+        }
+        let fr = self.frozen(s, self.control_on(t0));
+        let z = self.blocks_of(s);
+        for f in &self.vessel.forces {
+            if f.actuators() > 0 {
+                f.begin_memory(&fr, t0, &z, &mut s.act);
+            }
+        }
+    }
+    /// Rate-limited thrusters: record what they deliver at the end of the step.
+    fn end_step(&self, t_step: f64, t1: f64, s: &mut VesselState) {
+        if self.actuators == 0 {
+            return;
+        }
+        let fr = self.frozen(s, self.control_on(t_step));
+        let z = self.blocks_of(s);
+        for f in &self.vessel.forces {
+            if f.actuators() > 0 {
+                f.end_step(&fr, t1, &z, &mut s.act);
+            }
+        }
+    }
+    fn runge_kutta_refused(&self) -> Option<String> {
+        (self.actuators > 0).then(|| {
+            "rate-limited thrusters (thrusters.unit[*].thrust_rate, turn_rate) keep a memory from step to step that the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...), or remove the rate limits".into()
+        })
     }
     fn project(&self, s: &mut VesselState) -> Work {
         for f in &self.vessel.forces {
@@ -801,6 +840,7 @@ mod tests {
                 x: s.q * vel,
                 phi_th: if on { te } else { Vector3::zeros() },
                 phi_x: if on { s.x - xr } else { Vector3::zeros() },
+                act: Default::default(),
             }.to_vector();
             let scale = expect.norm();
             prop_assert!((full - expect).norm() <= 1e-13 * scale, "field mismatch {}", (full - expect).norm() / scale);

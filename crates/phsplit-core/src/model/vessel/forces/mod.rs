@@ -28,7 +28,7 @@
 //! stages with the Gauss weights, which for the quadratic storage H closes exactly.
 
 use super::params::Params;
-use super::state::VesselState;
+use super::state::{Actuators, VesselState};
 use super::Body;
 use crate::error::Result;
 use crate::flows::collocation::{Blocks, Z3};
@@ -148,6 +148,9 @@ pub struct Frozen<'a> {
     /// view at rest): a component whose force is not affine may put its linearisation there
     /// into the implicit rows and only the rest into its forcing (`damping_quadratic.rs`).
     pub velocity: [Vector3<f64>; 2],
+    /// What rate-limited thrusters delivered at the end of the last step (none for other
+    /// vessels, and in a view at rest).
+    pub actuators: Actuators,
 }
 
 impl Frozen<'_> {
@@ -391,4 +394,14 @@ pub trait Force: Debug + Send + Sync {
     fn position_origin(&self) -> Option<Vector3<f64>> {
         None
     }
+    /// How many actuators it keeps a memory of in the state ([`Actuators`]; the rate-limited
+    /// thrusters), 0 if none. At most one component may keep one.
+    fn actuators(&self) -> usize {
+        0
+    }
+    /// Start its actuators' memory at time `t` (block states `z`, frozen view `fr`), before a
+    /// run's first step.
+    fn begin_memory(&self, _fr: &Frozen, _t: f64, _z: &[Z3; 2], _act: &mut Actuators) {}
+    /// Record in its actuators' memory what they deliver at the end of a step, at time `t`.
+    fn end_step(&self, _fr: &Frozen, _t: f64, _z: &[Z3; 2], _act: &mut Actuators) {}
 }

@@ -36,7 +36,7 @@ use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::reference::{Interpolation, Reference, CHANNELS};
 use crate::model::vessel::params::{Params, Range};
-use crate::model::vessel::state::VesselState;
+use crate::model::vessel::state::{Actuators, VesselState};
 use crate::solve::{Account, AccountKind};
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
@@ -231,7 +231,7 @@ struct Moving {
 }
 
 /// An angle in (−π, π].
-fn wrap_pi(a: f64) -> f64 {
+pub(super) fn wrap_pi(a: f64) -> f64 {
     let w = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
     if w == -std::f64::consts::PI {
         std::f64::consts::PI
@@ -342,6 +342,16 @@ impl Pid {
         Self::demand_of(&self.rows(fr), self.moving(fr, t).as_ref(), &fr.nu(z), z)
     }
 
+    /// The demand in surge, sway and yaw `(X, Y, N)` at block states `z` and time `t`, zero
+    /// while the controller is off.
+    fn demand_tau(&self, fr: &Frozen, t: f64, z: &[Z3; 2]) -> Vector3<f64> {
+        if !fr.control_on {
+            return Vector3::zeros();
+        }
+        let (f, m) = self.demand(fr, t, z);
+        Vector3::new(f.x, f.y, m.z)
+    }
+
     /// The demand from the rows and the moving set point's part, already evaluated.
     fn demand_of(
         r: &PidRows,
@@ -381,7 +391,11 @@ impl Force for Pid {
             } else {
                 (Vector3::zeros(), Vector3::zeros())
             };
-            let a = th.allocate(&Vector3::new(f.x, f.y, m.z));
+            let tau = Vector3::new(f.x, f.y, m.z);
+            let a = match fr.actuators.n {
+                0 => th.allocate(&tau),
+                _ => th.allocate_limited(&tau, &fr.actuators, t - fr.actuators.t),
+            };
             for (k, (dof, unit)) in [("surge", "N"), ("sway", "N"), ("yaw", "N m")]
                 .iter()
                 .enumerate()
@@ -495,7 +509,12 @@ impl Force for Pid {
                 let r = self.rows(fr);
                 let nu = fr.nu(z);
                 let (f, m) = Self::demand_of(&r, mv.as_ref(), &nu, z);
-                let (force, moment) = th.wrench(&Vector3::new(f.x, f.y, m.z));
+                let tau = Vector3::new(f.x, f.y, m.z);
+                // Rate-limited thrusters deliver what they can reach from their memory.
+                let (force, moment) = match fr.actuators.n {
+                    0 => th.wrench(&tau),
+                    _ => th.wrench_of(&th.delivered(&tau, &fr.actuators, t - fr.actuators.t)),
+                };
                 // What the thrusters deliver, less the affine part already in flow S2.
                 let (rt, rr) = Self::allocated_rows(&r);
                 g.force(Sys::Trans, Some(0), force - rt.at(&nu, &z[0]));
@@ -512,6 +531,25 @@ impl Force for Pid {
     }
     fn position_origin(&self) -> Option<Vector3<f64>> {
         Some(self.position_reference)
+    }
+    fn actuators(&self) -> usize {
+        match &self.thrusters {
+            Some(th) if th.rate_limited() => th.units.len(),
+            _ => 0,
+        }
+    }
+    /// Rate-limited thrusters start delivering the demand at the run's start (none while the
+    /// controller is off).
+    fn begin_memory(&self, fr: &Frozen, t: f64, z: &[Z3; 2], act: &mut Actuators) {
+        if let Some(th) = &self.thrusters {
+            *act = th.memory_at(&self.demand_tau(fr, t, z), t);
+        }
+    }
+    fn end_step(&self, fr: &Frozen, t: f64, z: &[Z3; 2], act: &mut Actuators) {
+        if let Some(th) = &self.thrusters {
+            *act = th.delivered(&self.demand_tau(fr, t, z), act, t - act.t);
+            act.t = t;
+        }
     }
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
         if !fr.control_on {

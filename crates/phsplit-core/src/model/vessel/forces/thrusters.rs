@@ -10,7 +10,9 @@
 //!   - `max_thrust` (N, > 0); for `tunnel` and `fixed`, `min_thrust` (N, < 0; default
 //!     `−max_thrust` for a tunnel) and `angle` (degrees, the axis in the body's x–y plane from
 //!     x towards y; default 90 for a tunnel, 0 for a fixed propeller);
-//!   - `weight` (> 0, default 1): the cost of its thrust in the allocation.
+//!   - `weight` (> 0, default 1): the cost of its thrust in the allocation;
+//!   - `thrust_rate` (N/s, > 0, optional): the fastest change of its thrust; for an azimuth,
+//!     `turn_rate` (degrees/s, > 0, optional): its fastest turn.
 //!
 //! **Allocation** (T. A. Johansen and T. I. Fossen, "Control allocation — a survey",
 //! *Automatica* 49 (2013) 1087–1103, §2.2; Fossen, *Handbook of Marine Craft Hydrodynamics and
@@ -28,12 +30,18 @@
 //! its position, so a thruster below the body origin also heels and trims the vessel. The
 //! controller's demand in heave, roll and pitch is not delivered (horizontal thrusters).
 //!
-//! Not modelled: azimuth turning rates and thrust rates (they need thruster states, which
-//! the vessel's state does not have yet), thruster–hull and thruster–thruster interaction,
-//! forbidden sectors.
+//! **Rate limits** (docs/model.md §5.8): with any, what the thrusters delivered at the end of
+//! the last step is a memory the state carries ([`Actuators`]); at a time `t` within the step
+//! each thruster moves from it towards its command by at most its rate times `|t − t_m|`
+//! ([`Thrusters::delivered`]), so the limits hold exactly at every step.
+//!
+//! Not modelled: thruster–hull and thruster–thruster interaction, forbidden sectors, thrust
+//! lost while an azimuth turns.
 
+use super::pid::wrap_pi;
 use crate::error::{Error, Result};
 use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::state::{Actuators, MAX_ACTUATORS};
 use nalgebra::{Matrix3, Vector2, Vector3};
 use toml::{Table, Value};
 
@@ -63,6 +71,10 @@ pub struct Thruster {
     pub min_thrust: f64,
     pub max_thrust: f64,
     pub weight: f64,
+    /// The fastest change of the thrust (N/s), if limited.
+    pub thrust_rate: Option<f64>,
+    /// The fastest turn of an azimuth (rad/s), if limited.
+    pub turn_rate: Option<f64>,
 }
 
 /// The thrusters with their allocation, precomputed.
@@ -141,6 +153,15 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
         units.push(unit);
     }
     p.record_value(T, "unit", Value::Array(recorded));
+    let limited = units
+        .iter()
+        .any(|u| u.thrust_rate.is_some() || u.turn_rate.is_some());
+    if limited && units.len() > MAX_ACTUATORS {
+        return Err(Error::InvalidInput(format!(
+            "thrusters.unit has {} thrusters; with rate limits (thrust_rate, turn_rate) at most {MAX_ACTUATORS} are kept (their memory is part of the state): remove the rate limits or merge thrusters",
+            units.len()
+        )));
+    }
     Thrusters::new(units).map(Some)
 }
 
@@ -167,6 +188,13 @@ fn read_unit(p: &mut Params, s: &str, length: f64, beam: f64) -> Result<Thruster
         }
     }
     let max_thrust = p.f64(s, "max_thrust", "N", Range::Positive)?;
+    let thrust_rate = p.opt_f64(s, "thrust_rate", "N/s", Range::Positive)?;
+    let turn_rate = match kind {
+        Kind::Azimuth => p
+            .opt_f64(s, "turn_rate", "degrees/s", Range::Positive)?
+            .map(f64::to_radians),
+        _ => None,
+    };
     let weight = p
         .opt_f64(s, "weight", "dimensionless", Range::Positive)?
         .unwrap_or(1.0);
@@ -198,6 +226,8 @@ fn read_unit(p: &mut Params, s: &str, length: f64, beam: f64) -> Result<Thruster
         min_thrust,
         max_thrust,
         weight,
+        thrust_rate,
+        turn_rate,
     })
 }
 
@@ -304,6 +334,116 @@ impl Thrusters {
         (force, moment)
     }
 
+    /// Whether a thruster's thrust or turn is rate-limited: the vessel then keeps what the
+    /// thrusters deliver in its state ([`Actuators`]).
+    pub fn rate_limited(&self) -> bool {
+        self.units
+            .iter()
+            .any(|u| u.thrust_rate.is_some() || u.turn_rate.is_some())
+    }
+
+    /// Each thruster's commanded thrust and angle for the demand `tau` (the allocation, scaled
+    /// into the limits), at time `t`: the memory of thrusters that have just delivered their
+    /// command. An azimuth commanded no thrust keeps the angle `keep[i]`.
+    fn commanded(&self, tau: &Vector3<f64>, keep: &[f64]) -> Actuators {
+        let c = self.scale(tau);
+        let mut a = Actuators {
+            n: self.units.len(),
+            ..Actuators::default()
+        };
+        for (i, u) in self.units.iter().enumerate() {
+            let (fx, fy, along) = self.unit_force(i, tau);
+            (a.thrust[i], a.angle[i]) = match u.kind {
+                Kind::Azimuth => {
+                    let t = c * fx.hypot(fy);
+                    let angle = if t > 1e-12 * u.max_thrust {
+                        (c * fy).atan2(c * fx)
+                    } else {
+                        keep[i]
+                    };
+                    (t, angle)
+                }
+                _ => (c * along, u.angle),
+            };
+        }
+        a
+    }
+
+    /// What rate-limited thrusters deliver for the demand `tau`, `dt` seconds (of either sign:
+    /// a sub-step of a composition may run backwards) after they delivered `mem`: each
+    /// thruster's thrust moves towards its command by at most `thrust_rate · |dt|`, and an
+    /// azimuth turns towards its commanded angle, the short way, by at most
+    /// `turn_rate · |dt|` (docs/model.md §5.8). A command within reach is delivered exactly.
+    /// Delivered thrusts lie between the memory's and the command's, so within the limits.
+    pub fn delivered(&self, tau: &Vector3<f64>, mem: &Actuators, dt: f64) -> Actuators {
+        let n = self.units.len();
+        let mut out = self.commanded(tau, &mem.angle[..n]);
+        let dt = dt.abs();
+        for (i, u) in self.units.iter().enumerate() {
+            if let Some(r) = u.thrust_rate {
+                let step = out.thrust[i] - mem.thrust[i];
+                if step.abs() > r * dt {
+                    out.thrust[i] = mem.thrust[i] + (r * dt).copysign(step);
+                }
+            }
+            if let Some(r) = u.turn_rate {
+                let turn = wrap_pi(out.angle[i] - mem.angle[i]);
+                if turn.abs() > r * dt {
+                    out.angle[i] = wrap_pi(mem.angle[i] + (r * dt).copysign(turn));
+                }
+            }
+        }
+        out.t = mem.t + dt;
+        out
+    }
+
+    /// The memory of thrusters that deliver their command for the demand `tau` at time `t`
+    /// (how a run starts them; an idle azimuth points along the body's x axis).
+    pub fn memory_at(&self, tau: &Vector3<f64>, t: f64) -> Actuators {
+        let mut a = self.commanded(tau, &[0.0; MAX_ACTUATORS][..self.units.len()]);
+        a.t = t;
+        a
+    }
+
+    /// The force and moment (body frame, about the body origin) of thrusts and angles `a`.
+    pub fn wrench_of(&self, a: &Actuators) -> (Vector3<f64>, Vector3<f64>) {
+        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+        for (i, u) in self.units.iter().enumerate() {
+            let (s, c) = a.angle[i].sin_cos();
+            let f = Vector3::new(a.thrust[i] * c, a.thrust[i] * s, 0.0);
+            force += f;
+            moment += u.position.cross(&f);
+        }
+        (force, moment)
+    }
+
+    /// [`Self::allocate`] for rate-limited thrusters: the demand `tau`, and what they deliver
+    /// `dt` after `mem` ([`Self::delivered`]).
+    pub fn allocate_limited(&self, tau: &Vector3<f64>, mem: &Actuators, dt: f64) -> Allocation {
+        let d = self.delivered(tau, mem, dt);
+        let (force, moment) = self.wrench_of(&d);
+        let n = self.units.len();
+        let mut util: f64 = 0.0;
+        for (u, t) in self.units.iter().zip(&d.thrust[..n]) {
+            let lim = if *t >= 0.0 {
+                u.max_thrust
+            } else {
+                -u.min_thrust
+            };
+            util = util.max(t.abs() / lim);
+        }
+        Allocation {
+            commanded: *tau,
+            delivered: Vector3::new(force.x, force.y, moment.z),
+            scale: self.scale(tau),
+            thrust: d.thrust[..n].to_vec(),
+            angle: d.angle[..n].to_vec(),
+            utilisation: util,
+            force,
+            moment,
+        }
+    }
+
     /// Allocate the demand `(X, Y, N)`, with each thruster's thrust and angle.
     pub fn allocate(&self, tau: &Vector3<f64>) -> Allocation {
         let n = self.units.len();
@@ -361,6 +501,8 @@ mod tests {
             min_thrust: -max,
             max_thrust: max,
             weight: 1.0,
+            thrust_rate: None,
+            turn_rate: None,
         };
         let a = |y: f64, max: f64| Thruster {
             kind: Kind::Azimuth,
@@ -369,6 +511,8 @@ mod tests {
             min_thrust: 0.0,
             max_thrust: max,
             weight: 1.0,
+            thrust_rate: None,
+            turn_rate: None,
         };
         Thrusters::new(vec![
             t(37.0, 300e3),
@@ -409,6 +553,66 @@ mod tests {
         assert!((a.utilisation - 1.0).abs() < 1e-12);
     }
 
+    /// The OSV's thrusters with thrust rates of 10 kN/s and azimuths turning at 0.1 rad/s.
+    fn limited() -> Thrusters {
+        let mut units = osv().units;
+        for u in &mut units {
+            u.thrust_rate = Some(1e4);
+            if u.kind == Kind::Azimuth {
+                u.turn_rate = Some(0.1);
+            }
+        }
+        Thrusters::new(units).unwrap()
+    }
+
+    #[test]
+    fn rate_limits_move_from_the_memory_towards_the_command() {
+        let th = limited();
+        assert!(th.rate_limited() && !osv().rate_limited());
+        let tau = Vector3::new(-2e5, 1.5e5, 4e6);
+        let cmd = th.memory_at(&tau, 0.0);
+        // idle thrusters, the azimuths pointing along x: after 2 s each thrust is 20 kN towards
+        // its command (or the command, if nearer), each azimuth turned 0.2 rad the short way
+        let idle = th.memory_at(&Vector3::zeros(), 0.0);
+        assert!(idle.thrust[..4].iter().all(|t| *t == 0.0) && idle.angle[2] == 0.0);
+        let d = th.delivered(&tau, &idle, 2.0);
+        for i in 0..4 {
+            let want = cmd.thrust[i].clamp(-2e4, 2e4);
+            assert!(
+                (d.thrust[i] - want).abs() <= 1e-9 * 2e4,
+                "{i}: {} vs {want}",
+                d.thrust[i]
+            );
+        }
+        for i in [2, 3] {
+            let turn = wrap_pi(cmd.angle[i]);
+            assert!((d.angle[i] - turn.clamp(-0.2, 0.2)).abs() < 1e-15, "{i}");
+        }
+        // a command within reach is delivered exactly, and the wrench is the allocation's
+        let near = th.delivered(&tau, &cmd, 0.5);
+        assert_eq!(&near.thrust[..4], &cmd.thrust[..4]);
+        let (f, m) = th.wrench_of(&near);
+        let a = th.allocate(&tau);
+        assert!(
+            (f - a.force).norm() <= 1e-9 * a.force.norm()
+                && (m - a.moment).norm() <= 1e-9 * a.moment.norm()
+        );
+        // the turn goes the short way across ±π, and either sign of the time works
+        let mut back = cmd;
+        back.angle[2] = 3.1;
+        let d = th.delivered(&tau, &back, -1.0);
+        let moved = wrap_pi(d.angle[2] - 3.1);
+        assert!(moved.abs() <= 0.1 + 1e-15);
+        assert!(
+            wrap_pi(cmd.angle[2] - 3.1) * moved >= 0.0,
+            "turned the short way"
+        );
+        // an azimuth commanded no thrust keeps its angle
+        let d = th.delivered(&Vector3::zeros(), &back, 100.0);
+        assert_eq!(d.angle[2], 3.1);
+        assert_eq!(d.thrust[2], 0.0);
+    }
+
     #[test]
     fn thrusters_on_one_line_cannot_allocate_yaw() {
         let u = |x: f64| Thruster {
@@ -418,6 +622,8 @@ mod tests {
             min_thrust: -1e5,
             max_thrust: 1e5,
             weight: 1.0,
+            thrust_rate: None,
+            turn_rate: None,
         };
         let e = Thrusters::new(vec![u(10.0), u(-10.0)])
             .unwrap_err()

@@ -1,0 +1,141 @@
+"""Issue 12: thrust and azimuth rate limits (docs/model.md §5.8). What rate-limited thrusters
+deliver is a memory the state carries from step to step. Checked here: the limits hold at every
+step while they bind; a ramp from rest matches its closed form; limits that never bind change
+nothing; a run cut into calls, or continued from a saved state, is the same run; the ledger
+books what the thrusters deliver and closes; bad rate data and Runge-Kutta methods are refused
+with messages."""
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+import phsplit
+from phsplit.results import run_chunks
+from test_operation import OSV_THRUSTERS, vessel
+
+TURN = 10.0  # degrees/s: an illustrative azimuth turning rate (36 s for a full turn)
+
+
+def limited(thrust_fraction=0.1, turn=TURN, tunnels=True):
+    """The OSV's thrusters with thrust rates `thrust_fraction` of their capacity per second and
+    the azimuths turning at `turn` degrees/s (illustrative values, not a published vessel's)."""
+    th = copy.deepcopy(OSV_THRUSTERS)
+    for u in th["unit"]:
+        if u["kind"] == "azimuth" or tunnels:
+            u["thrust_rate"] = thrust_fraction * u["max_thrust"]
+        if u["kind"] == "azimuth":
+            u["turn_rate"] = turn
+    return th
+
+
+def outputs(s):
+    return {k: s.outputs[k][2] for k in s.outputs}
+
+
+@pytest.mark.parametrize("method,h", [("sp2", 0.5), ("sp4", 0.5), ("sp2", 2.0)])
+def test_rate_limits_hold_at_every_step(method, h):
+    """The paper's run starts 80 m off its set point: the demand jumps far beyond what the
+    thrusters can follow. Every thruster's thrust changes by at most its rate times the step, every
+    azimuth turns by at most its turning rate times the step, and both bind often."""
+    th = limited()
+    v = vessel(thrusters=th)
+    s = phsplit.simulate(v, (0.0, 300.0), h, method, control_start=0.0)
+    assert s.status == "completed"
+    o = outputs(s)
+    for i, u in enumerate(th["unit"]):
+        thrust = o[f"thruster{i}_thrust"]
+        d_thrust = np.abs(np.diff(thrust))
+        reach = u["thrust_rate"] * h
+        assert d_thrust.max() <= reach * (1 + 1e-9), (i, d_thrust.max() / reach)
+        assert (d_thrust >= reach * (1 - 1e-9)).sum() >= 5, i  # the limit binds
+        assert np.all(thrust <= u["max_thrust"] * (1 + 1e-12)) and np.all(thrust >= -u["max_thrust"] * (1 + 1e-12))
+        if u["kind"] == "azimuth":
+            turn = np.abs((np.diff(np.radians(o[f"thruster{i}_angle"])) + np.pi) % (2 * np.pi) - np.pi)
+            assert turn.max() <= np.radians(TURN) * h * (1 + 1e-9), (i, turn.max())
+            assert (turn >= np.radians(TURN) * h * (1 - 1e-9)).sum() >= 3, i
+            assert np.all(thrust >= 0.0)
+    # what the outputs report is the memory the state carries
+    for i in range(len(th["unit"])):
+        np.testing.assert_array_equal(s.actuators[:, 1 + i], o[f"thruster{i}_thrust"])
+    np.testing.assert_array_equal(s.actuators[:, 0], s.t)
+    # the ledger books what they deliver, and closes
+    assert np.all(s.ledger.relative_residual() < 1e-10)
+    k = list(s.ledger.by_account).index("thrusters")
+    dlv = np.column_stack([o["delivered_surge"], o["delivered_sway"]])
+    np.testing.assert_allclose(s.account_force[:, k, :2], dlv, rtol=0, atol=1e-6 * np.abs(dlv).max())
+
+
+def test_a_ramp_from_rest_is_the_closed_form():
+    """Controller off until t = 10 s: the thrusters idle. Then, 1 km off the set point, the
+    demand jumps beyond their capacity and stays there; each tunnel thruster ramps at its rate,
+    T(t) = r (t - 10) (sign of the command), for the 6 s that follow (it would need 20 s to
+    reach its capacity): the closed form, at every step, to round-off."""
+    th = limited(thrust_fraction=0.05)
+    v = vessel(thrusters=th)
+    y0 = v.initial_state(position=[780.0 + 700.0, 20.0 - 700.0, 0.0])
+    h = 0.25
+    s = phsplit.simulate(v, (0.0, 16.0), h, "sp4", control_start=10.0, initial=y0)
+    assert s.outputs["thrust_utilisation"][2][-1] < 0.5  # far from the command, still ramping
+    o = outputs(s)
+    before = s.t <= 10.0
+    for i, u in enumerate(th["unit"]):
+        assert np.all(o[f"thruster{i}_thrust"][before] == 0.0), i
+    after = s.t > 10.0
+    r = 0.05 * 300e3
+    for i in (0, 1):  # the tunnels: the demand of the paper's start asks far more than 6 s of ramp
+        t_i = o[f"thruster{i}_thrust"][after]
+        expect = np.sign(t_i[-1]) * r * (s.t[after] - 10.0)
+        np.testing.assert_allclose(t_i, expect, rtol=1e-12, atol=1e-6)
+
+
+def test_limits_that_never_bind_change_nothing():
+    """Rates far above anything the run asks: the results equal those without rate limits, to
+    round-off of the thrusters' polar form."""
+    free = phsplit.simulate(vessel(thrusters=OSV_THRUSTERS), (0.0, 200.0), 0.5, "sp2", control_start=0.0)
+    fast = phsplit.simulate(vessel(thrusters=limited(thrust_fraction=1e9, turn=1e9)), (0.0, 200.0), 0.5, "sp2",
+                            control_start=0.0)
+    scale = np.abs(free.x).max()
+    assert np.abs(fast.x - free.x).max() <= 1e-9 * scale
+    np.testing.assert_allclose(fast.p, free.p, rtol=0, atol=1e-9 * np.abs(free.p).max())
+
+
+def test_a_run_cut_into_calls_or_continued_from_a_state_is_one_run():
+    v = vessel(thrusters=limited())
+    settings = phsplit.Settings(t_span=(0.0, 60.0), h=0.5, method="sp2", control_start=0.0)
+    one = phsplit.simulate(v, settings=settings)
+    parts = list(run_chunks(v, settings, v.initial_state(), [40, 50, 30]))
+    assert [p.status for p in parts] == ["completed"] * 3
+    last = parts[-1]
+    np.testing.assert_array_equal(last.state(-1), one.state(-1))
+    assert len(one.state(-1)) == 27 + 1 + 2 * 4
+    # a user's continuation from a saved state, memory included
+    rest = phsplit.simulate(v, initial=one.state(80), settings=phsplit.Settings(
+        t_span=(40.0, 60.0), h=0.5, method="sp2", control_start=0.0))
+    np.testing.assert_array_equal(rest.state(-1), one.state(-1))
+    # outputs at chosen times go through the same memory
+    at = phsplit.simulate(v, settings=settings, save_at=[7.25, 30.0])
+    assert np.all(np.isfinite(at.actuators)) and at.actuators.shape == (2, 9)
+    np.testing.assert_array_equal(at.state(1), one.state(60))
+
+
+def test_runge_kutta_and_bad_rates_are_refused_with_messages():
+    v = vessel(thrusters=limited())
+    with pytest.raises(phsplit.InvalidInputError, match="rate-limited thrusters .* use a splitting method"):
+        phsplit.simulate(v, (0.0, 5.0), 0.5, "rk4", control_start=0.0)
+    bad = copy.deepcopy(OSV_THRUSTERS)
+    bad["unit"][0]["thrust_rate"] = -1.0
+    with pytest.raises(phsplit.InvalidInputError, match=r"thrusters.unit\[0\].thrust_rate must be > 0 \(N/s\)"):
+        vessel(thrusters=bad)
+    bad = copy.deepcopy(OSV_THRUSTERS)
+    bad["unit"][0]["turn_rate"] = 10.0  # a tunnel thruster does not turn
+    with pytest.raises(phsplit.InvalidInputError, match=r"unknown field `turn_rate` in \[thrusters.unit\[0\]\]"):
+        vessel(thrusters=bad)
+    many = copy.deepcopy(limited())
+    many["unit"] = many["unit"] * 3
+    with pytest.raises(phsplit.InvalidInputError, match="at most 8 are kept"):
+        vessel(thrusters=many)
+    state = v.initial_state()
+    with pytest.raises(phsplit.InvalidInputError, match="or 36 with the memory of the vessel's 4 rate-limited"):
+        phsplit.simulate(v, (0.0, 1.0), 0.5, "sp2", initial=np.concatenate([state, [0.0, 1.0]]))
