@@ -170,9 +170,17 @@ OSV_THRUSTERS = {"hull_length": 83.0, "hull_beam": 18.0, "unit": [
     {"kind": "azimuth", "position": [-41.5, -7.0, -3.0], "max_thrust": 655e3}]}
 
 
+# The OSV's thrusters with rate limits (illustrative: half the capacity per second, azimuths
+# turning at 90 degrees/s) that the runs below never reach (checked where it matters).
+RATED_THRUSTERS = dict(OSV_THRUSTERS, unit=[
+    dict(u, thrust_rate=0.5 * u["max_thrust"], **({"turn_rate": 90.0} if u["kind"] == "azimuth" else {}))
+    for u in OSV_THRUSTERS["unit"]])
+
+
 def operation_vessel(thrusters=False, speed=2.0):
+    """The pipe, a moving set point and, with ``thrusters`` (True, or a thrusters table), thrusters."""
     y_top = upright(vessel())[18:21] + np.array([-60.0, 0.0, 3.0])
-    extra = {"thrusters": OSV_THRUSTERS} if thrusters else {}
+    extra = {"thrusters": OSV_THRUSTERS if thrusters is True else thrusters} if thrusters else {}
     return vessel(pipe={"submerged_weight": 1500.0, "water_depth": 300.0, "hang_off": [-60.0, 0.0, 3.0],
                         "touchdown": [float(y_top[0] - 500.0), float(y_top[1] + 30.0)], "lay_speed": 0.5,
                         "lay_direction": 10.0},
@@ -181,8 +189,10 @@ def operation_vessel(thrusters=False, speed=2.0):
 
 
 @pytest.mark.parametrize("method,order,thrusters", [("sp2", 2, False), ("sp4", 4, False), ("sp2", 2, True),
-                                                    ("sp4", 4, True)])
+                                                    ("sp4", 4, True), ("sp2", 2, "rated"), ("sp4", 4, "rated")])
 def test_orders_with_the_pipe_and_a_moving_set_point_against_the_independent_model(method, order, thrusters):
+    if thrusters == "rated":  # rate-limited thrusters whose limits do not bind: the same orders
+        thrusters = RATED_THRUSTERS
     v = operation_vessel(thrusters, speed=0.05 if thrusters else 2.0)
     if thrusters:
         # near the set point, so that the thrusters are not saturated (checked below)
@@ -199,6 +209,13 @@ def test_orders_with_the_pipe_and_a_moving_set_point_against_the_independent_mod
     if thrusters:
         util = s.outputs["thrust_utilisation"][2]
         assert np.all(util < 1.0) and util.max() > 0.05, util.max()
+    if thrusters is RATED_THRUSTERS:
+        assert s.actuators is not None
+        for i, u in enumerate(RATED_THRUSTERS["unit"]):
+            reach = u["thrust_rate"] * 2.0 ** -5
+            assert np.abs(np.diff(s.outputs[f"thruster{i}_thrust"][2])).max() < 0.9 * reach, i
+            turn = np.abs(np.diff(s.outputs[f"thruster{i}_angle"][2]))  # degrees, no wrap near here
+            assert turn.max() < 0.9 * u.get("turn_rate", np.inf) * 2.0 ** -5, i
 
 
 @pytest.mark.parametrize("method", ["lie", "sp2", "sp4", "sp6"])

@@ -37,28 +37,33 @@ def outputs(s):
 @pytest.mark.parametrize("method,h", [("sp2", 0.5), ("sp4", 0.5), ("sp2", 2.0)])
 def test_rate_limits_hold_at_every_step(method, h):
     """The paper's run starts 80 m off its set point: the demand jumps far beyond what the
-    thrusters can follow. Every thruster's thrust changes by at most its rate times the step, every
-    azimuth turns by at most its turning rate times the step, and both bind often."""
+    thrusters can follow. At every step a tunnel thruster's thrust changes by at most its rate
+    times the step, an azimuth's force vector too (so its thrust as well), and an azimuth turns by
+    at most its turning rate times the step; each limit binds often."""
     th = limited()
     v = vessel(thrusters=th)
     s = phsplit.simulate(v, (0.0, 300.0), h, method, control_start=0.0)
     assert s.status == "completed"
     o = outputs(s)
+    n = len(th["unit"])
+    thrust, angle = s.actuators[:, 1:1 + n], s.actuators[:, 1 + n:]
     for i, u in enumerate(th["unit"]):
-        thrust = o[f"thruster{i}_thrust"]
-        d_thrust = np.abs(np.diff(thrust))
         reach = u["thrust_rate"] * h
-        assert d_thrust.max() <= reach * (1 + 1e-9), (i, d_thrust.max() / reach)
-        assert (d_thrust >= reach * (1 - 1e-9)).sum() >= 5, i  # the limit binds
-        assert np.all(thrust <= u["max_thrust"] * (1 + 1e-12)) and np.all(thrust >= -u["max_thrust"] * (1 + 1e-12))
         if u["kind"] == "azimuth":
-            turn = np.abs((np.diff(np.radians(o[f"thruster{i}_angle"])) + np.pi) % (2 * np.pi) - np.pi)
+            f = thrust[:, i, None] * np.column_stack([np.cos(angle[:, i]), np.sin(angle[:, i])])
+            change = np.linalg.norm(np.diff(f, axis=0), axis=1)
+            turn = np.abs((np.diff(angle[:, i]) + np.pi) % (2 * np.pi) - np.pi)
             assert turn.max() <= np.radians(TURN) * h * (1 + 1e-9), (i, turn.max())
             assert (turn >= np.radians(TURN) * h * (1 - 1e-9)).sum() >= 3, i
-            assert np.all(thrust >= 0.0)
-    # what the outputs report is the memory the state carries
-    for i in range(len(th["unit"])):
-        np.testing.assert_array_equal(s.actuators[:, 1 + i], o[f"thruster{i}_thrust"])
+            assert np.all(thrust[:, i] >= 0.0)
+        else:
+            change = np.abs(np.diff(thrust[:, i]))
+        assert change.max() <= reach * (1 + 1e-9), (i, change.max() / reach)
+        assert (change >= reach * (1 - 1e-9)).sum() >= 5, i  # the limit binds
+        assert np.abs(np.diff(thrust[:, i])).max() <= reach * (1 + 1e-9)
+        assert np.all(np.abs(thrust[:, i]) <= u["max_thrust"] * (1 + 1e-12))
+        # what the outputs report is the memory the state carries
+        np.testing.assert_allclose(o[f"thruster{i}_thrust"], thrust[:, i], rtol=1e-14, atol=1e-9)
     np.testing.assert_array_equal(s.actuators[:, 0], s.t)
     # the ledger books what they deliver, and closes
     assert np.all(s.ledger.relative_residual() < 1e-10)
@@ -66,6 +71,29 @@ def test_rate_limits_hold_at_every_step(method, h):
     dlv = np.column_stack([o["delivered_surge"], o["delivered_sway"]])
     np.testing.assert_allclose(s.account_force[:, k, :2], dlv, rtol=0, atol=1e-6 * np.abs(dlv).max())
 
+
+@pytest.mark.parametrize("turn", [None, TURN])
+def test_a_command_that_reverses_is_followed_through_zero(turn):
+    """Thrust rates on every thruster, with and without the azimuths' turning rate, on the
+    shipped pipe-lay scenario, whose surge demand changes sign within seconds: an azimuth's
+    force passes through small values instead of jumping, so flow S2's fixed point converges
+    and the run completes at the scenario's step and at a tenth of it."""
+    import tomllib
+    from importlib import resources
+
+    sc = tomllib.loads(resources.files("phsplit").joinpath("scenarios/pipelay.toml").read_text())
+    th = copy.deepcopy(sc["thrusters"])
+    for u in th["unit"]:
+        u["thrust_rate"] = 3.0e4
+        if turn and u["kind"] == "azimuth":
+            u["turn_rate"] = turn
+    tables = {k: sc[k] for k in ("setpoint", "pipe")}
+    v = vessel(thrusters=th, **tables)
+    y0 = v.initial_state(**sc["initial"])
+    for h in (0.5, 0.05):
+        s = phsplit.simulate(v, (0.0, 60.0), h, "sp2", control_start=0.0, initial=y0)
+        assert s.status == "completed", (h, s.failure)
+        assert np.all(s.ledger.relative_residual() < 1e-10)
 
 def test_a_ramp_from_rest_is_the_closed_form():
     """Controller off until t = 10 s: the thrusters idle. Then, 1 km off the set point, the
@@ -120,6 +148,35 @@ def test_a_run_cut_into_calls_or_continued_from_a_state_is_one_run():
     np.testing.assert_array_equal(at.state(1), one.state(60))
 
 
+@pytest.mark.parametrize("method,outer,project", [("sp2", "conservative", False), ("sp4", "dissipative", False),
+                                                   ("sp2", "dissipative", True)])
+def test_what_is_saved_does_not_change_the_run(method, outer, project):
+    """The memory is written at every step's end, so no sub-step merges across a step boundary
+    with rate-limited thrusters: saving every 4th state, or keeping running maxima, gives the
+    same states bitwise."""
+    v = vessel(thrusters=limited())
+    kw = dict(t_span=(0.0, 120.0), h=0.5, method=method, control_start=0.0, outer=outer, project_invariants=project)
+    every = phsplit.simulate(v, settings=phsplit.Settings(**kw, save_every=1))
+    some = phsplit.simulate(v, settings=phsplit.Settings(**kw, save_every=4))
+    peaks = phsplit.simulate(v, settings=phsplit.Settings(**kw, save_every=4), running_max=True)
+    assert every.status == some.status == "completed"
+    np.testing.assert_array_equal(some.x, every.x[::4])
+    np.testing.assert_array_equal(some.actuators, every.actuators[::4])
+    np.testing.assert_array_equal(peaks.x, some.x)
+
+
+def test_states_with_the_memory_go_where_states_go():
+    """Vessel.energy, Vessel.outputs and event conditions take a state with the memory after it."""
+    from phsplit import events as E
+
+    v = vessel(thrusters=limited())
+    s = phsplit.simulate(v, (0.0, 30.0), 0.5, "sp2", control_start=0.0,
+                         events=[E.energy_above(1e30), E.watch_circle(1e6)])
+    assert s.status == "completed" and len(s.state(3)) == 36
+    assert v.energy(s.state(3)) == pytest.approx(s.energy[3], rel=1e-14)
+    assert v.energy(s.state(3)) == v.energy(s.state(3)[:27])
+
+
 def test_runge_kutta_and_bad_rates_are_refused_with_messages():
     v = vessel(thrusters=limited())
     with pytest.raises(phsplit.InvalidInputError, match="rate-limited thrusters .* use a splitting method"):
@@ -139,3 +196,22 @@ def test_runge_kutta_and_bad_rates_are_refused_with_messages():
     state = v.initial_state()
     with pytest.raises(phsplit.InvalidInputError, match="or 36 with the memory of the vessel's 4 rate-limited"):
         phsplit.simulate(v, (0.0, 1.0), 0.5, "sp2", initial=np.concatenate([state, [0.0, 1.0]]))
+    # a memory that is not one a run could have written
+    s = phsplit.simulate(v, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
+    y = s.state(-1)
+    run = lambda y, t0=10.0: phsplit.simulate(v, (t0, t0 + 1.0), 0.5, "sp2", control_start=0.0, initial=y)  # noqa: E731
+    assert run(y).status == "completed"
+    with pytest.raises(phsplit.InvalidInputError, match=r"memory after the state is at t = 10 s, but the run starts at t0 = 0"):
+        run(y, 0.0)
+    bad = y.copy()
+    bad[27 + 1 + 2] = 1e9  # thruster 2's thrust
+    with pytest.raises(phsplit.InvalidInputError, match=r"thruster 2 \(azimuth\) a thrust of 1000000000 N; allowed: 0 to 420000"):
+        run(bad)
+    bad = y.copy()
+    bad[27 + 1 + 4 + 0] = 0.3  # a tunnel thruster's angle is its axis
+    with pytest.raises(phsplit.InvalidInputError, match=r"thruster 0 \(tunnel\) an angle of 0.3 rad; allowed: its axis"):
+        run(bad)
+    bad = y.copy()
+    bad[27 + 1 + 4 + 3] = 100.0
+    with pytest.raises(phsplit.InvalidInputError, match=r"thruster 3 \(azimuth\) an angle of 100 rad"):
+        run(bad)

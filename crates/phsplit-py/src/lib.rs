@@ -133,7 +133,8 @@ impl PyVessel {
             .collect()
     }
     /// The natural periods (s, ascending) of the oscillating modes of flow S2 linearised at
-    /// the attitude of a flat 27-vector `state`, with the controller on or off
+    /// the attitude of a flat 27-vector `state` (a memory of rate-limited thrusters after it is
+    /// allowed), with the controller on or off
     /// (`VesselSystem::natural_periods`).
     #[pyo3(signature = (state, control))]
     fn natural_periods(
@@ -141,7 +142,8 @@ impl PyVessel {
         state: PyReadonlyArray1<'_, f64>,
         control: bool,
     ) -> PyResult<Vec<f64>> {
-        let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;
+        let s = VesselState::from_slice_user(&entries(&state), true, self.inner.actuators())
+            .map_err(to_py)?;
         Ok(VesselSystem::new(&self.inner, None).natural_periods(&s.q, control))
     }
     /// What the components report at a flat 27-vector state and time `t` (the pipe's tension,
@@ -163,9 +165,11 @@ impl PyVessel {
             .map(|o| (o.name, o.value))
             .collect())
     }
-    /// The stored energy H of eq. (35) at a flat 27-vector state (J).
+    /// The stored energy H of eq. (35) at a flat 27-vector state (J; a memory of rate-limited
+    /// thrusters after it is allowed: it stores no energy).
     fn energy(&self, state: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
-        let s = VesselState::from_slice_checked(&entries(&state), true).map_err(to_py)?;
+        let s = VesselState::from_slice_user(&entries(&state), true, self.inner.actuators())
+            .map_err(to_py)?;
         Ok(self.inner.energy(&s))
     }
     /// The initial state as a flat 27-vector (p, m, Q column-major, mu, x, phi_th, phi_x),

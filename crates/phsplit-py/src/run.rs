@@ -76,6 +76,10 @@ fn integrate<'py>(
                 .map_err(to_py)?
         }
     };
+    vessel
+        .inner
+        .check_memory(&y0, settings.t_span.0)
+        .map_err(to_py)?;
     let v = vessel.inner.clone();
     let s2 = settings.clone();
     let mut monitor = PyMonitor {

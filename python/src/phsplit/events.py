@@ -12,7 +12,8 @@ from the grid state before it (each trial one method step of length ``τ``), to 
 s``. The crossing time is then as accurate as the method's states are. A terminal event ends the
 run at the crossing; otherwise it is recorded and the run goes on. Built-in conditions:
 :func:`watch_circle` (horizontal distance to the set point), :func:`roll_beyond`,
-:func:`pitch_beyond`, :func:`energy_above`; any callable ``g(t, y)`` on the flat 27-vector state
+:func:`pitch_beyond`, :func:`energy_above`; any callable ``g(t, y)`` on the flat 27-vector state (followed, for a vessel with rate-limited
+thrusters, by their memory: see :meth:`Solution.state`)
 works too.
 
 Energy statement: the states at ``save_at`` times and at events lie on the method's own
@@ -71,7 +72,8 @@ class Event:
 
 @dataclass(frozen=True)
 class EventHit:
-    """An event found: its name, time (s), the state there (flat 27-vector) and whether it
+    """An event found: its name, time (s), the state there (flat 27-vector, with the thrusters' memory after it for rate-limited
+    thrusters) and whether it
     ended the run."""
 
     name: str

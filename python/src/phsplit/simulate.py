@@ -124,7 +124,8 @@ class Vessel:
         return self._inner.to_dict()
 
     def energy(self, state: np.ndarray) -> float:
-        """Stored energy H (eq. 35, J) of a flat 27-vector state."""
+        """Stored energy H (eq. 35, J) of a flat 27-vector state (a thrusters' memory after it is
+        allowed and stores nothing)."""
         return self._inner.energy(np.ascontiguousarray(state, dtype=float))
 
     def initial_state(self, **overrides: Sequence[float]) -> np.ndarray:
@@ -580,7 +581,8 @@ def simulate(
     ``save_every``-th step and the last. ``project_invariants`` (default on) turns the attitude
     after every step so that the restoring invariant ``mu = G Q^T e3`` of the exact flow holds
     again; it changes no energy (docs/model.md §3.6); ``False`` runs the paper's scheme as
-    printed. ``initial`` overrides the vessel's initial state: a flat 27-vector or a mapping with ``euler``, ``position``, ``velocity``,
+    printed. ``initial`` overrides the vessel's initial state: a flat 27-vector (for rate-limited thrusters optionally
+    followed by their memory, as :meth:`Solution.state` gives it) or a mapping with ``euler``, ``position``, ``velocity``,
     ``angular_velocity``. ``linear_flow`` integrates the linear flow S2 by Gauss collocation of
     the method's order (``"gauss"``, the default: the diagonal Padé approximant, same order,
     still passive, paper Remark 2.3; 2 to 8 times sooner to a given accuracy, README) or

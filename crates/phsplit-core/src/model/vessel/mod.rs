@@ -255,6 +255,17 @@ impl Vessel {
         self.forces.iter().map(|f| f.actuators()).sum()
     }
 
+    /// Check the memory of rate-limited thrusters a state brings, for a run from `t0`
+    /// ([`Force::check_memory`]); a state without one passes.
+    pub fn check_memory(&self, s: &VesselState, t0: f64) -> Result<()> {
+        if s.act.n == 0 {
+            return Ok(());
+        }
+        self.forces
+            .iter()
+            .try_for_each(|f| f.check_memory(&s.act, t0))
+    }
+
     /// The energy `H` of eq. (35), J (without constant terms).
     pub fn energy(&self, s: &VesselState) -> f64 {
         self.body.kinetic_energy(s) + self.forces.iter().map(|f| f.storage(s)).sum::<f64>()

@@ -606,8 +606,14 @@ impl Model for VesselSystem<'_> {
 impl SplitModel for VesselSystem<'_> {
     /// Flow S1 is exact for a mass matrix of the paper's form (the free rigid body's elliptic
     /// flow), not for Kirchhoff's collocation; flow S2 is exact when it is the matrix
-    /// exponential (no forcing, `linear_flow = "exact"`), not when it is collocated.
+    /// exponential (no forcing, `linear_flow = "exact"`), not when it is collocated. Nothing
+    /// merges with rate-limited thrusters.
     fn merges_exactly(&self, flow: Flow) -> bool {
+        // Rate-limited thrusters write their memory at every step's end (`Model::end_step`):
+        // a sub-step merged across the boundary would skip it.
+        if self.actuators > 0 {
+            return false;
+        }
         match flow {
             Flow::S1 => self.vessel.body.kirchhoff.is_none(),
             Flow::S2 => !self.forced && self.linear == LinearFlow::Exact,

@@ -404,4 +404,8 @@ pub trait Force: Debug + Send + Sync {
     fn begin_memory(&self, _fr: &Frozen, _t: f64, _z: &[Z3; 2], _act: &mut Actuators) {}
     /// Record in its actuators' memory what they deliver at the end of a step, at time `t`.
     fn end_step(&self, _fr: &Frozen, _t: f64, _z: &[Z3; 2], _act: &mut Actuators) {}
+    /// Check a memory a run is given to start from (a user's state), for a run from `t0`.
+    fn check_memory(&self, _act: &Actuators, _t0: f64) -> Result<()> {
+        Ok(())
+    }
 }

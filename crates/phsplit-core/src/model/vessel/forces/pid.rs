@@ -545,6 +545,12 @@ impl Force for Pid {
             *act = th.memory_at(&self.demand_tau(fr, t, z), t);
         }
     }
+    fn check_memory(&self, act: &Actuators, t0: f64) -> crate::error::Result<()> {
+        match &self.thrusters {
+            Some(th) => th.check_memory(act, t0),
+            None => Ok(()),
+        }
+    }
     fn end_step(&self, fr: &Frozen, t: f64, z: &[Z3; 2], act: &mut Actuators) {
         if let Some(th) = &self.thrusters {
             *act = th.delivered(&self.demand_tau(fr, t, z), act, t - act.t);
