@@ -215,3 +215,27 @@ def test_runge_kutta_and_bad_rates_are_refused_with_messages():
     bad[27 + 1 + 4 + 3] = 100.0
     with pytest.raises(phsplit.InvalidInputError, match=r"thruster 3 \(azimuth\) an angle of 100 rad"):
         run(bad)
+
+
+def test_the_fmu_carries_the_memory_across_communication_steps(tmp_path):
+    """An FMU of the pipe-lay scenario with rate-limited thrusters: its communication steps (1 s,
+    two internal steps) continue the memory, so its positions are simulate's."""
+    from dataclasses import replace
+    from importlib import resources
+
+    from fmpy import simulate_fmu
+
+    from phsplit import fmu, scenario
+
+    text = resources.files("phsplit").joinpath("scenarios/pipelay.toml").read_text()
+    text = text.replace("max_thrust = 3.0e5\n", "max_thrust = 3.0e5\nthrust_rate = 3.0e4\n")
+    text = text.replace("max_thrust = 4.2e5\n", "max_thrust = 4.2e5\nthrust_rate = 3.0e4\nturn_rate = 10.0\n")
+    assert text.count("thrust_rate") == 3
+    (tmp_path / "rl.toml").write_text(text)
+    sc = scenario.load(str(tmp_path / "rl.toml"))
+    r = simulate_fmu(str(fmu.export(sc, tmp_path / "rl.fmu")), stop_time=60.0, output_interval=1.0,
+                     output=["position.x", "position.y"])
+    sol = phsplit.simulate(sc.vessel, settings=replace(sc.settings, t_span=(0.0, 60.0), save_every=2))
+    assert sol.actuators is not None and np.allclose(sol.t, r["time"])
+    np.testing.assert_allclose(r["position.x"], sol.x[:, 0], rtol=1e-12)
+    np.testing.assert_allclose(r["position.y"], sol.x[:, 1], rtol=1e-12)
