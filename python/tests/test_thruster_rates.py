@@ -239,3 +239,27 @@ def test_the_fmu_carries_the_memory_across_communication_steps(tmp_path):
     assert sol.actuators is not None and np.allclose(sol.t, r["time"])
     np.testing.assert_allclose(r["position.x"], sol.x[:, 0], rtol=1e-12)
     np.testing.assert_allclose(r["position.y"], sol.x[:, 1], rtol=1e-12)
+
+
+def test_a_thrusters_numbers_can_be_swept():
+    """Sweeps address a table of a list: `thrusters.unit[i].name`, also a rate the unit does
+    not have yet; a case equals the simulation of its vessel, and bad paths are named."""
+    base = vessel(thrusters=OSV_THRUSTERS)
+    cases = [{"thrusters.unit[0].max_thrust": 2.0e5, "thrusters.unit[2].turn_rate": 5.0},
+             {"thrusters.unit[3].position[1]": -6.0},
+             {"thrusters.unit[0].turn_rate": 5.0}]  # a tunnel thruster does not turn
+    ds = phsplit.simulate_many(cases, base=base, t_span=(0.0, 20.0), h=0.5, method="sp2", control_start=0.0)
+    assert list(ds.status.values) == ["completed", "completed", "invalid"]
+    assert "turn_rate" in ds["error"].values[2] and "thrusters.unit[0]" in ds["error"].values[2]
+    v = phsplit.with_parameters(base, cases[0])
+    units = v.to_dict()["thrusters"]["unit"]
+    assert units[0]["max_thrust"] == 2.0e5 and units[2]["turn_rate"] == 5.0
+    direct = phsplit.simulate(v, (0.0, 20.0), 0.5, "sp2", control_start=0.0)
+    np.testing.assert_array_equal(ds.position.values[0], direct.x)
+    for path, words in [("thrusters.unit[7].max_thrust", r"index 7 out of range \(0..3\)"),
+                        ("thrusters.unit[0].max_thrus", "unknown field `max_thrus` in \\[thrusters.unit\\[0\\]\\]; "
+                                                        "did you mean 'max_thrust'"),
+                        ("thrusters.unit[0]", "thrusters.unit\\[0\\] is a table: name one of its numbers"),
+                        ("thrusters.unit.max_thrust", "thrusters.unit is not a table; give an index there")]:
+        with pytest.raises(phsplit.InvalidInputError, match=words):
+            phsplit.with_parameters(base, {path: 1.0})

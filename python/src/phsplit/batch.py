@@ -35,67 +35,85 @@ import numpy as np
 from . import _core
 from .simulate import Settings, Vessel, settings_to_toml, simulate
 
-_PATH = re.compile(r"^([a-z_]+)\.([a-z_]+)(?:\[([0-9]+)\])?(?:\[([0-9]+)\])?$")
+_PATH = re.compile(r"^([a-z_]+)((?:\.[a-z_]+|\[[0-9]+\])+)$")
+_SEGMENT = re.compile(r"\.([a-z_]+)|\[([0-9]+)\]")
 #: Matrices that are symmetric by definition: an off-diagonal entry sets its mirror too.
 _SYMMETRIC = {("vessel", "added_mass"), ("vessel", "damping_matrix")}
+_SHAPES = ("a parameter path is 'table.name', 'table.name[i]', 'table.name[i][j]' (a matrix entry) or "
+           "'table.list[i].name' (a table of a list, like thrusters.unit[0].max_thrust)")
 
 
-def _resolve(d: dict, key: str) -> tuple[str, str, tuple[int, ...]]:
-    """Check a parameter path against a vessel's dict: (table, name, indices)."""
+def _resolve(d: dict, key: str) -> list[str | int]:
+    """Check a parameter path against a vessel's dict: the keys and indices that lead to its
+    number (the last key of a table in a list may be new: the vessel file's reader checks it)."""
     if not isinstance(key, str):
-        raise _core.InvalidInputError(
-            f"a parameter path is a string 'table.name', 'table.name[i]' or 'table.name[i][j]', got {key!r}")
+        raise _core.InvalidInputError(f"{_SHAPES}, got {key!r}")
     m = _PATH.match(key)
-    if not m or not isinstance(d.get(m.group(1)), dict) or m.group(2) not in d[m.group(1)]:
+    segs: list[str | int] = []
+    if m:
+        segs = [m.group(1)] + [g1 if g1 else int(g2) for g1, g2 in _SEGMENT.findall(m.group(2))]
+    if not m or not isinstance(segs[1], str) or not isinstance(d.get(segs[0]), dict) or segs[1] not in d[segs[0]]:
         valid = sorted(f"{s}.{k}" for s in d if isinstance(d[s], dict) for k in d[s])
-        raise _core.InvalidInputError(
-            f"unknown parameter {key!r}; parameters are table.name, table.name[i] or table.name[i][j] "
-            f"(a matrix entry), one of: {', '.join(valid)}")
-    sec, name = m.group(1), m.group(2)
-    idx = tuple(int(g) for g in (m.group(3), m.group(4)) if g is not None)
-    cur = d[sec][name]
-    rank = 0
-    if isinstance(cur, (list, tuple)):
-        rank = 2 if cur and all(isinstance(r, (list, tuple)) for r in cur) else 1
-    if len(idx) != rank:
-        if rank == 0:
-            shape = "a scalar: give no index"
-        elif rank == 1:
-            shape = f"a {len(cur)}-vector: give one index, e.g. {sec}.{name}[0]"
+        raise _core.InvalidInputError(f"unknown parameter {key!r}; {_SHAPES}, one of: {', '.join(valid)}")
+    cur: object = d
+    for n, seg in enumerate(segs):
+        where = segs[0] + "".join(f".{x}" if isinstance(x, str) else f"[{x}]" for x in segs[1:n])
+        if isinstance(seg, int):
+            if not isinstance(cur, (list, tuple)):
+                raise _core.InvalidInputError(f"parameter {key!r}: {where} is not a list; give no index there")
+            if seg >= len(cur):
+                raise _core.InvalidInputError(f"parameter {key!r}: index {seg} out of range (0..{len(cur) - 1})")
+            cur = cur[seg]
         else:
-            shape = f"a {len(cur)}-row matrix: give two indices, e.g. {sec}.{name}[0][0]"
-        raise _core.InvalidInputError(f"parameter {key!r}: {sec}.{name} is {shape}")
-    if rank >= 1:
-        size = [len(cur)] + ([len(cur[idx[0]])] if rank == 2 and idx[0] < len(cur) else [])
-        for i, n in zip(idx, size):
-            if i >= n:
-                raise _core.InvalidInputError(f"parameter {key!r}: index {i} out of range (0..{n - 1})")
-    return sec, name, idx
+            if not isinstance(cur, dict):
+                raise _core.InvalidInputError(f"parameter {key!r}: {where} is not a table; give an index there")
+            new_key = seg not in cur and n == len(segs) - 1 and n >= 3 and isinstance(segs[n - 1], int)
+            if seg not in cur and not new_key:
+                raise _core.InvalidInputError(f"unknown parameter {key!r}: {where} has no {seg!r}; it has "
+                                              f"{', '.join(sorted(cur))}")
+            cur = cur.get(seg, 0.0)
+    if isinstance(cur, (list, tuple)):
+        # name the list the path starts indexing (a matrix needs both its indices)
+        k = next((n for n in range(2, len(segs)) if isinstance(segs[n], int)), len(segs))
+        j = k
+        while j < len(segs) and isinstance(segs[j], int):
+            j += 1
+        whole = d[segs[0]]
+        for seg in segs[1:k]:
+            whole = whole[seg]
+        name = segs[0] + "".join(f".{x}" for x in segs[1:k])
+        matrix = bool(whole) and all(isinstance(r, (list, tuple)) for r in whole)
+        shape = (f"a {len(whole)}-row matrix: give two indices, e.g. {name}[0][0]" if matrix
+                 else f"a {len(whole)}-vector: give one index, e.g. {name}[0]")
+        raise _core.InvalidInputError(f"parameter {key!r}: {name} is {shape}")
+    if isinstance(cur, dict):
+        raise _core.InvalidInputError(f"parameter {key!r}: {key} is a table: name one of its numbers "
+                                      f"({', '.join(sorted(cur))})")
+    return segs
 
 
 def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
     """``base`` with parameters replaced: keys ``table.name``, ``table.name[i]`` or, for a
     matrix, ``table.name[i][j]`` of the vessel file (``vessel``, ``control``, ``initial``,
-    ``external``, …). In the symmetric matrices ``vessel.added_mass`` and
-    ``vessel.damping_matrix`` an off-diagonal entry sets its mirror ``[j][i]`` too. Unknown paths
-    and bad values raise InvalidInputError."""
+    ``external``, …), and ``table.list[i].name`` (``[i]``) for a table of a list
+    (``thrusters.unit[0].max_thrust``, ``thrusters.unit[2].turn_rate``). In the symmetric
+    matrices ``vessel.added_mass`` and ``vessel.damping_matrix`` an off-diagonal entry sets its
+    mirror ``[j][i]`` too. Unknown paths and bad values raise InvalidInputError."""
     if not isinstance(base, Vessel):
         raise _core.InvalidInputError(f"base must be a phsplit.Vessel, got {type(base).__name__}")
     if not isinstance(params, Mapping):
         raise _core.InvalidInputError(f"parameters must be a mapping of paths to numbers, got {type(params).__name__}")
     d = base.to_dict()
     for key, value in params.items():
-        sec, name, idx = _resolve(d, key)
+        segs = _resolve(d, key)
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
             raise _core.InvalidInputError(f"parameter {key!r} must be a number, got {value!r}")
-        if not idx:
-            d[sec][name] = float(value)
-        elif len(idx) == 1:
-            d[sec][name][idx[0]] = float(value)
-        else:
-            d[sec][name][idx[0]][idx[1]] = float(value)
-            if (sec, name) in _SYMMETRIC:
-                d[sec][name][idx[1]][idx[0]] = float(value)
+        parent = d
+        for seg in segs[:-1]:
+            parent = parent[seg]
+        parent[segs[-1]] = float(value)
+        if tuple(segs[:2]) in _SYMMETRIC and len(segs) == 4:
+            d[segs[0]][segs[1]][segs[3]][segs[2]] = float(value)
     return Vessel.from_dict(d, f"{base.source} with {dict(params)}")
 
 
