@@ -7,8 +7,8 @@
 //! quadrature all follow from each account's force rows: with `ν = M⁻¹u` the power of a force
 //! `f = F z̄` is the quadratic form `uᵀ M⁻¹ F z̄` of the augmented block state `z̄ = (u, v, w, 1)`.
 
-use super::forces::{Forcing, Frozen, Output, Rows, S2Builder, Sys};
-use super::state::VesselState;
+use super::forces::{Force, Forcing, Frozen, Output, Rows, S2Builder, Sys};
+use super::state::{Actuators, VesselState};
 use super::Vessel;
 use crate::error::{Error, Result};
 use crate::flows::collocation::Z3;
@@ -478,6 +478,25 @@ impl<'a> VesselSystem<'a> {
     }
 }
 
+impl VesselSystem<'_> {
+    /// Let each component with actuators update their memory in `s` (the view of `s` with the
+    /// controller `on`).
+    fn update_memory(
+        &self,
+        s: &mut VesselState,
+        on: bool,
+        update: impl Fn(&dyn Force, &Frozen, &[Z3; 2], &mut Actuators),
+    ) {
+        let fr = self.frozen(s, on);
+        let z = self.blocks_of(s);
+        for f in &self.vessel.forces {
+            if f.actuators() > 0 {
+                update(f.as_ref(), &fr, &z, &mut s.act);
+            }
+        }
+    }
+}
+
 /// The accounts whose forces make up the controller's force in the probe ([`Model::probe`]):
 /// its P, I and D parts, or what its thrusters deliver.
 const CONTROL_ACCOUNTS: [&str; 3] = ["control", "control_damping", "thrusters"];
@@ -566,28 +585,18 @@ impl Model for VesselSystem<'_> {
     /// Rate-limited thrusters: start their memory with what they deliver at `t0`, unless the
     /// state brings it (a run continued from an earlier call's last state).
     fn begin(&self, t0: f64, s: &mut VesselState) {
-        if self.actuators == 0 || s.act.n == self.actuators {
-            return;
-        }
-        let fr = self.frozen(s, self.control_on(t0));
-        let z = self.blocks_of(s);
-        for f in &self.vessel.forces {
-            if f.actuators() > 0 {
-                f.begin_memory(&fr, t0, &z, &mut s.act);
-            }
+        if self.actuators > 0 && s.act.n != self.actuators {
+            self.update_memory(s, self.control_on(t0), |f, fr, z, act| {
+                f.begin_memory(fr, t0, z, act)
+            });
         }
     }
     /// Rate-limited thrusters: record what they deliver at the end of the step.
     fn end_step(&self, t_step: f64, t1: f64, s: &mut VesselState) {
-        if self.actuators == 0 {
-            return;
-        }
-        let fr = self.frozen(s, self.control_on(t_step));
-        let z = self.blocks_of(s);
-        for f in &self.vessel.forces {
-            if f.actuators() > 0 {
-                f.end_step(&fr, t1, &z, &mut s.act);
-            }
+        if self.actuators > 0 {
+            self.update_memory(s, self.control_on(t_step), |f, fr, z, act| {
+                f.end_step(fr, t1, z, act)
+            });
         }
     }
     fn runge_kutta_refused(&self) -> Option<String> {
