@@ -260,6 +260,21 @@ def test_a_thrusters_numbers_can_be_swept():
                         ("thrusters.unit[0].max_thrus", "unknown field `max_thrus` in \\[thrusters.unit\\[0\\]\\]; "
                                                         "did you mean 'max_thrust'"),
                         ("thrusters.unit[0]", "thrusters.unit\\[0\\] is a table: name one of its numbers"),
-                        ("thrusters.unit.max_thrust", "thrusters.unit is not a table; give an index there")]:
+                        ("thrusters.unit.max_thrust", "thrusters.unit is a list: give an index there"),
+                        ("thrusters.unit", r"a list of 4 tables: give an index and a name, e\.g\. thrusters\.unit\[0\]\.max_thrust"),
+                        ("thrusters.unit[0].position", r"thrusters\.unit\[0\]\.position is a 3-vector: give one index"),
+                        ("control.kp_rotational[2].x", r"control\.kp_rotational\[2\] is a number: end the path there")]:
         with pytest.raises(phsplit.InvalidInputError, match=words):
             phsplit.with_parameters(base, {path: 1.0})
+
+
+def test_a_continued_run_reruns_from_its_file(tmp_path):
+    """A run continued from a saved state records the thrusters' memory in its file's
+    initial_state, so `rerun` repeats it bitwise."""
+    v = vessel(thrusters=limited())
+    a = phsplit.simulate(v, (0.0, 10.0), 0.5, "sp2", control_start=0.0)
+    b = phsplit.simulate(v, (10.0, 20.0), 0.5, "sp2", control_start=0.0, initial=a.state(-1))
+    b.to_xarray().to_netcdf(tmp_path / "b.nc")
+    with phsplit.open_dataset(tmp_path / "b.nc") as ds:
+        assert ds["initial_state"].size == 36
+        assert phsplit.results.compare(ds, phsplit.rerun(ds)) == []

@@ -402,8 +402,12 @@ class Solution:
             ds[name] = var(("time",), values, unit, long_name)
         prov = self.meta.get("provenance", {})
         if "initial_state" in prov:
-            ds["initial_state"] = var(("state",), prov["initial_state"], "1",
-                                      "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; SI units)")
+            y0 = prov["initial_state"]
+            ds["initial_state"] = var(("state",), y0, "1",
+                                      "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; SI units)"
+                                      if len(y0) == 27 else
+                                      "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; then the "
+                                      "rate-limited thrusters' memory: time, thrusts, angles in rad; SI units)")
         ds["time"].encoding["_FillValue"] = None  # CF 2.5.1: no fill value on a coordinate
         # Time is the record (unlimited) dimension, as in the CLI's files: appendable, and the
         # vector dimensions may then follow it (CF 2.4).
@@ -696,6 +700,6 @@ def simulate(
     )
     # What reruns it (phsplit rerun): the vessel file, the initial state the core used, one chunk.
     sol.meta["running_max"] = dict(raw["running_max"])
-    sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0)[:27],
+    sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0),
                               "chunks": [int(used["n_steps"])]}
     return sol
