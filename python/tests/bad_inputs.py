@@ -420,3 +420,13 @@ CATALOGUE += [
         lambda: phsplit.simulate(vessel_with("[initial]", _rated())(), (0.0, 5.0), 0.5, "rk4", control_start=0.0), E,
         ("rate-limited thrusters", "splitting method")),
 ]
+
+CATALOGUE += [
+    Bad("CLI: sweep over a string", cli("sweep", "s.toml", "--out", "st", files={
+        "s.toml": b'[simulation]\nh = 1.0\n[sweep]\nmode = "grid"\n[sweep.parameters]\n"vessel.mass" = ["a", "b"]\n'}),
+        C, ("sweep.parameters.vessel.mass must hold numbers", "'a'")),
+    Bad("symmetric matrix entry set twice, differently",
+        lambda: phsplit.with_parameters(phsplit.Vessel.preset("osv"),
+                                        {"vessel.added_mass[1][5]": 1.0, "vessel.added_mass[5][1]": 2.0}), E,
+        ("vessel.added_mass[1][5]", "vessel.added_mass[5][1]", "different values")),
+]

@@ -205,3 +205,37 @@ def test_summary_peaks_cover_every_step_not_only_the_saved_ones():
     ds = phsplit.simulate_many([{"vessel.mass": 6.3622085e6}], settings=phsplit.Settings(
         t_span=(0.0, 100.0), h=0.25, method="sp2", control_start=10.0, save_every=50))
     assert abs(float(ds["peak_force_N"][0]) - peak) <= 1e-12 * peak
+
+
+def test_a_task_lost_outside_its_case_is_reported_not_stored(tmp_path, monkeypatch):
+    """A task that fails for a reason outside its case (here: its function raises, as Dask's
+    KilledWorker does after a worker died again and again) is listed in the summary as an error
+    but not stored, so the next run of the sweep computes it."""
+    from dask.distributed import LocalCluster
+
+    import phsplit.batch as batch
+
+    f = tmp_path / "grid.toml"
+    f.write_text(SWEEP_TOML.format(t_end=20.0, h=0.5).replace("[-1.0, 6e6, 7e6]", "[6e6]"))
+    sw = load_sweep(str(f))
+    store = tmp_path / "store"
+    real = batch._run_case
+    lost_id = sw.case_id(1)
+
+    def flaky(base_tables, settings, case, store=None, cid=None):
+        if cid == lost_id:
+            raise RuntimeError("worker lost")
+        return real(base_tables, settings, case, store, cid)
+
+    monkeypatch.setattr(batch, "_run_case", flaky)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        res = run_sweep(sw, str(store), scheduler=cluster.scheduler_address, progress=False)
+        assert res["lost"] == 1 and res["computed"] == 2
+        assert done_cases(str(store)) == {sw.case_id(0), sw.case_id(2)}
+        with phsplit.open_dataset(store / "summary.nc") as s:
+            assert list(s["status"].values) == ["completed", "error", "completed"]
+            assert "worker lost" in str(s["error"].values[1]) and "run the sweep again" in str(s["error"].values[1])
+        monkeypatch.setattr(batch, "_run_case", real)
+        res = run_sweep(sw, str(store), scheduler=cluster.scheduler_address, progress=False)
+    assert res["computed"] == 1 and res["lost"] == 0 and res["reused"] == 2
+    assert done_cases(str(store)) == {sw.case_id(i) for i in range(3)}

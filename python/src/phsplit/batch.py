@@ -6,15 +6,20 @@
 * :func:`run_sweep` (CLI: ``phsplit sweep``) expands a grid or a random sample of parameters into
   cases and runs them on ``dask.distributed``: a ``LocalCluster`` bound to 127.0.0.1 started for
   the run, or an existing cluster given by address.
-  - Each finished case is written by the client to ``STORE/cases/<id>.nc`` (temporary file, then
-    rename), so a case is stored once, whole, or not at all.
+  - Each finished case is written to ``STORE/cases/<id>.nc`` (temporary file, then rename), so
+    a case is stored once, whole, or not at all: by the workers of a LocalCluster, by the client
+    for a cluster given by address.
   - A rerun on the same store computes only the missing cases.
   - A worker that dies loses only its running tasks, which Dask reschedules.
   - A case that fails (bad parameters, divergence) is stored with its error and does not stop
     the others.
+  - A case whose task fails for a reason outside the case (a worker killed again and again:
+    Dask's ``KilledWorker``) is listed in the summary with status ``error`` but not stored, so
+    the next run of the sweep computes it.
 
 A *case* is a mapping of parameter paths to values, applied to a base vessel: ``vessel.mass``,
-``control.kp_rotational[2]``, ``initial.euler[0]``, ... (the sections and keys of a vessel file).
+``control.kp_rotational[2]``, ``initial.euler[0]``, ``thrusters.unit[0].max_thrust``, ... (the
+sections and keys of a vessel file).
 """
 from __future__ import annotations
 
@@ -66,25 +71,29 @@ def _resolve(d: dict, key: str) -> list[str | int]:
             cur = cur[seg]
         else:
             if not isinstance(cur, dict):
-                raise _core.InvalidInputError(f"parameter {key!r}: {where} is not a table; give an index there")
+                what = ("a list: give an index there" if isinstance(cur, (list, tuple))
+                        else "a number: end the path there")
+                raise _core.InvalidInputError(f"parameter {key!r}: {where} is {what}")
             new_key = seg not in cur and n == len(segs) - 1 and n >= 3 and isinstance(segs[n - 1], int)
             if seg not in cur and not new_key:
                 raise _core.InvalidInputError(f"unknown parameter {key!r}: {where} has no {seg!r}; it has "
                                               f"{', '.join(sorted(cur))}")
             cur = cur.get(seg, 0.0)
     if isinstance(cur, (list, tuple)):
-        # name the list the path starts indexing (a matrix needs both its indices)
-        k = next((n for n in range(2, len(segs)) if isinstance(segs[n], int)), len(segs))
-        j = k
-        while j < len(segs) and isinstance(segs[j], int):
-            j += 1
-        whole = d[segs[0]]
-        for seg in segs[1:k]:
+        # name the list the path's last name gives (a matrix needs both its indices)
+        k = max(n for n, x in enumerate(segs) if isinstance(x, str)) + 1
+        whole = d
+        for seg in segs[:k]:
             whole = whole[seg]
-        name = segs[0] + "".join(f".{x}" for x in segs[1:k])
-        matrix = bool(whole) and all(isinstance(r, (list, tuple)) for r in whole)
-        shape = (f"a {len(whole)}-row matrix: give two indices, e.g. {name}[0][0]" if matrix
-                 else f"a {len(whole)}-vector: give one index, e.g. {name}[0]")
+        name = segs[0] + "".join(f".{x}" if isinstance(x, str) else f"[{x}]" for x in segs[1:k])
+        if all(isinstance(r, dict) for r in whole):
+            example = next((n for n, v in (whole[0] if whole else {}).items()
+                            if isinstance(v, (int, float)) and not isinstance(v, bool)), "name")
+            shape = f"a list of {len(whole)} tables: give an index and a name, e.g. {name}[0].{example}"
+        elif bool(whole) and all(isinstance(r, (list, tuple)) for r in whole):
+            shape = f"a {len(whole)}-row matrix: give two indices, e.g. {name}[0][0]"
+        else:
+            shape = f"a {len(whole)}-vector: give one index, e.g. {name}[0]"
         raise _core.InvalidInputError(f"parameter {key!r}: {name} is {shape}")
     if isinstance(cur, dict):
         raise _core.InvalidInputError(f"parameter {key!r}: {key} is a table: name one of its numbers "
@@ -104,6 +113,7 @@ def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
     if not isinstance(params, Mapping):
         raise _core.InvalidInputError(f"parameters must be a mapping of paths to numbers, got {type(params).__name__}")
     d = base.to_dict()
+    mirrored: dict[tuple, tuple[str, float]] = {}  # symmetric entries set, by (table, name, i, j)
     for key, value in params.items():
         segs = _resolve(d, key)
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
@@ -113,6 +123,12 @@ def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
             parent = parent[seg]
         parent[segs[-1]] = float(value)
         if tuple(segs[:2]) in _SYMMETRIC and len(segs) == 4:
+            entry = (segs[0], segs[1], min(segs[2:]), max(segs[2:]))
+            if entry in mirrored and mirrored[entry][1] != float(value):
+                raise _core.InvalidInputError(
+                    f"parameters {mirrored[entry][0]!r} and {key!r} set the same entry of the symmetric matrix "
+                    f"{segs[0]}.{segs[1]} to different values ({mirrored[entry][1]} and {float(value)})")
+            mirrored[entry] = (key, float(value))
             d[segs[0]][segs[1]][segs[3]][segs[2]] = float(value)
     return Vessel.from_dict(d, f"{base.source} with {dict(params)}")
 
@@ -298,6 +314,11 @@ def load_sweep(path: str) -> Sweep:
     d0 = sc.vessel.to_dict()
     for k in keys:
         _resolve(d0, k)  # the paths are checked now; the values case by case
+        spec = params[k]
+        values = list(spec.values()) if isinstance(spec, dict) else spec if isinstance(spec, list) else [spec]
+        bad = [v for v in values if isinstance(v, bool) or not isinstance(v, (int, float))]
+        if bad:
+            raise _core.ScenarioParseError(f"{path}: sweep.parameters.{k} must hold numbers, got {bad[0]!r}")
     if mode == "grid":
         for k in keys:
             if not isinstance(params[k], list) or not params[k]:
@@ -418,6 +439,7 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
     publish(tmp, os.path.join(store, "sweep.json"))  # whole or not at all
     cluster = None
     rows: dict[str, dict] = {}  # the summary rows of the cases computed now
+    lost: list[str] = []  # cases whose task failed outside the case: not stored
     t0 = time.perf_counter()
     if todo:
         if scheduler:
@@ -439,19 +461,28 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                     cid = futures[fut]
                     try:
                         result = fut.result()
-                    except Exception as e:  # noqa: BLE001 - a case's crash is recorded, not fatal
-                        result = {"status": "error", "error": f"{type(e).__name__}: {e}",
-                                  "case": sweep.cases[ids.index(cid)]}
+                    except Exception as e:  # noqa: BLE001 - a task's failure is reported, not fatal
+                        # Not the case's own outcome (that comes back as a result): listed in the
+                        # summary, not stored, so that the next run computes it.
+                        lost.append(cid)
+                        rows[cid] = _summary_row(cid, sweep.cases[ids.index(cid)], {}, "error",
+                                                 f"{type(e).__name__}: {e} (not stored: run the sweep again)")
+                        bar.update(1)
+                        continue
                     rows[cid] = result["row"] if "row" in result else _write_case(store, cid, result)
                     bar.update(1)
         finally:
             client.close()
             if cluster is not None:
                 cluster.close()
+                # a worker killed while writing a case leaves its temporary file
+                for f in os.listdir(os.path.join(store, "cases")):
+                    if f.startswith(".tmp-"):
+                        os.unlink(os.path.join(store, "cases", f))
     elapsed = time.perf_counter() - t0
     summary = write_summary(store, ids, rows)
-    return {"cases": len(ids), "computed": len(todo), "reused": len(ids) - len(todo), "seconds": elapsed,
-            "summary": summary}
+    return {"cases": len(ids), "computed": len(todo) - len(lost), "reused": len(ids) - len(todo), "lost": len(lost),
+            "seconds": elapsed, "summary": summary}
 
 
 def write_summary(store: str, ids: list[str], known: dict[str, dict] | None = None) -> str:

@@ -460,6 +460,8 @@ def _sweep(args) -> int:
     div = [r for r in rows if r.get("diverged") == "True"]
     print(f"{res['computed']} computed, {res['reused']} already in the store, in {res['seconds']:.1f} s; "
           f"{len(bad)} failed or invalid, {len(div)} diverged")
+    if res["lost"]:
+        print(f"{res['lost']} cases were lost with their workers and not stored: run the sweep again to compute them")
     print(f"summary: {os.path.abspath(res['summary'])}")
     return 0
 
