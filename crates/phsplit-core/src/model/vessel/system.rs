@@ -6,8 +6,12 @@
 //! field plus S2's; the ledger's power, its exact integrals (Van Loan Gramian) and its Gauss
 //! quadrature all follow from each account's force rows: with `ν = M⁻¹u` the power of a force
 //! `f = F z̄` is the quadratic form `uᵀ M⁻¹ F z̄` of the augmented block state `z̄ = (u, v, w, 1)`.
+//!
+//! Flows S1 and S2 are `system/s1.rs` and `system/s2.rs`; what the vessel reports at a state (the
+//! components' outputs, each account's wrench, the controller's wrench for the probe) is
+//! `system/report.rs`.
 
-use super::forces::{Force, Forcing, Frozen, Output, Rows, S2Builder, Sys};
+use super::forces::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use super::state::{Actuators, VesselState};
 use super::Vessel;
 use crate::error::{Error, Result};
@@ -18,6 +22,7 @@ use crate::methods::Flow;
 use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
 use nalgebra::{Matrix3, SVector, Vector3};
 
+mod report;
 mod s1;
 mod s2;
 
@@ -441,41 +446,6 @@ impl<'a> VesselSystem<'a> {
         }
         w
     }
-
-    /// The quantities the components report at `s` and time `t` ([`super::forces::Force::outputs`]).
-    pub fn outputs(&self, s: &VesselState, t: f64) -> Vec<Output> {
-        let mut out = Vec::new();
-        let fr = self.frozen(s, self.control_on(t));
-        let z = self.blocks_of(s);
-        for f in &self.vessel.forces {
-            f.outputs(&fr, &z, s, t, &mut out);
-        }
-        out
-    }
-
-    /// The force (N) and moment (N m) on the body, body frame, of each account at `s` and
-    /// time `t`.
-    pub fn account_wrenches(
-        &self,
-        s: &VesselState,
-        t: f64,
-        on: bool,
-    ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
-        let fr = self.frozen(s, on);
-        let b = self.s2_of(&fr, true);
-        let booked = b.booked.expect("built with the ledger");
-        let z = self.blocks_of(s);
-        let nu = self.vessel.body.velocity(&s.p, &s.m);
-        let g = self.forcing(&fr, t, &z);
-        (0..self.accounts.len())
-            .map(|k| {
-                (
-                    booked[k][0].at(&nu, &z[0]) + g.booked[k][0],
-                    booked[k][1].at(&nu, &z[1]) + g.booked[k][1],
-                )
-            })
-            .collect()
-    }
 }
 
 impl VesselSystem<'_> {
@@ -494,44 +464,6 @@ impl VesselSystem<'_> {
                 update(f.as_ref(), &fr, &z, &mut s.act);
             }
         }
-    }
-}
-
-/// The accounts whose forces make up the controller's force in the probe ([`Model::probe`]):
-/// its P, I and D parts, or what its thrusters deliver.
-const CONTROL_ACCOUNTS: [&str; 3] = ["control", "control_damping", "thrusters"];
-
-impl VesselSystem<'_> {
-    /// The controller's force and moment (body frame, about the body origin) at `s` on a step
-    /// that starts at `t`: the sum of [`Self::account_wrenches`] over [`CONTROL_ACCOUNTS`],
-    /// assembled from the components that book to them only (the probe runs after every step).
-    fn control_wrench(&self, s: &VesselState, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let fr = self.frozen(s, self.control_on(t));
-        let z = self.blocks_of(s);
-        let mut b = S2Builder::new(Some(self.accounts.len()));
-        let mut g = Forcing::new();
-        for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
-            if f.accounts()
-                .iter()
-                .any(|a| CONTROL_ACCOUNTS.contains(&a.name))
-            {
-                b.base = base;
-                f.add_s2(&fr, &mut b);
-                if f.forced() {
-                    g.base = base;
-                    f.add_forcing(&fr, t, &z, &mut g);
-                }
-            }
-        }
-        let booked = b.booked.expect("built with the ledger");
-        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
-        for (k, a) in self.accounts.iter().enumerate() {
-            if CONTROL_ACCOUNTS.contains(&a.name) {
-                force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked[k][0];
-                moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked[k][1];
-            }
-        }
-        (force, moment)
     }
 }
 
@@ -689,6 +621,7 @@ impl FieldModel<{ super::STATE_DIM }> for VesselSystem<'_> {
 #[cfg(test)]
 mod tests {
     use super::super::forces::external::{External, Frame};
+    use super::report::CONTROL_ACCOUNTS;
     use super::*;
     use proptest::prelude::*;
 

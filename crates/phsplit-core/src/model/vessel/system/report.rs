@@ -1,0 +1,80 @@
+//! What the vessel reports at a state, for the results and the probe: the components'
+//! outputs, the force and moment of each ledger account, and the controller's wrench.
+
+use super::super::forces::{Forcing, Output, S2Builder};
+use super::super::state::VesselState;
+use super::VesselSystem;
+use nalgebra::Vector3;
+
+/// The accounts whose forces make up the controller's force in the probe
+/// ([`crate::solve::Model::probe`]): its P, I and D parts, or what its thrusters deliver.
+pub(super) const CONTROL_ACCOUNTS: [&str; 3] = ["control", "control_damping", "thrusters"];
+
+impl VesselSystem<'_> {
+    /// The quantities the components report at `s` and time `t` ([`super::forces::Force::outputs`]).
+    pub fn outputs(&self, s: &VesselState, t: f64) -> Vec<Output> {
+        let mut out = Vec::new();
+        let fr = self.frozen(s, self.control_on(t));
+        let z = self.blocks_of(s);
+        for f in &self.vessel.forces {
+            f.outputs(&fr, &z, s, t, &mut out);
+        }
+        out
+    }
+
+    /// The force (N) and moment (N m) on the body, body frame, of each account at `s` and
+    /// time `t`.
+    pub fn account_wrenches(
+        &self,
+        s: &VesselState,
+        t: f64,
+        on: bool,
+    ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+        let fr = self.frozen(s, on);
+        let b = self.s2_of(&fr, true);
+        let booked = b.booked.expect("built with the ledger");
+        let z = self.blocks_of(s);
+        let nu = self.vessel.body.velocity(&s.p, &s.m);
+        let g = self.forcing(&fr, t, &z);
+        (0..self.accounts.len())
+            .map(|k| {
+                (
+                    booked[k][0].at(&nu, &z[0]) + g.booked[k][0],
+                    booked[k][1].at(&nu, &z[1]) + g.booked[k][1],
+                )
+            })
+            .collect()
+    }
+
+    /// The controller's force and moment (body frame, about the body origin) at `s` on a step
+    /// that starts at `t`: the sum of [`Self::account_wrenches`] over [`CONTROL_ACCOUNTS`],
+    /// assembled from the components that book to them only (the probe runs after every step).
+    pub(super) fn control_wrench(&self, s: &VesselState, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let fr = self.frozen(s, self.control_on(t));
+        let z = self.blocks_of(s);
+        let mut b = S2Builder::new(Some(self.accounts.len()));
+        let mut g = Forcing::new();
+        for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
+            if f.accounts()
+                .iter()
+                .any(|a| CONTROL_ACCOUNTS.contains(&a.name))
+            {
+                b.base = base;
+                f.add_s2(&fr, &mut b);
+                if f.forced() {
+                    g.base = base;
+                    f.add_forcing(&fr, t, &z, &mut g);
+                }
+            }
+        }
+        let booked = b.booked.expect("built with the ledger");
+        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+        for (k, a) in self.accounts.iter().enumerate() {
+            if CONTROL_ACCOUNTS.contains(&a.name) {
+                force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked[k][0];
+                moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked[k][1];
+            }
+        }
+        (force, moment)
+    }
+}
