@@ -1,4 +1,4 @@
 //! Rotations and the special functions of the exact flows.
-mod double_double;
+pub(crate) mod double_double;
 pub mod elliptic;
 pub mod so3;

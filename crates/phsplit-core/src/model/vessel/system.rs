@@ -95,6 +95,9 @@ pub struct VesselSystem<'a> {
     gave_up: std::sync::Arc<std::sync::atomic::AtomicU8>,
     /// How many rate-limited thrusters the state remembers ([`VesselState::act`]).
     pub actuators: usize,
+    /// The exact flow S2's balance beyond the structural one, per controller state and block
+    /// system: computed once, at the upright attitude (`s2.rs`, `exact_balance`).
+    exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
 }
 
 /// Why a sub-flow gave up rather than return an unconverged result.
@@ -147,6 +150,7 @@ impl<'a> VesselSystem<'a> {
                 .any(|f| f.forced() && !f.forcing_uses_state()),
             gave_up: Default::default(),
             actuators: vessel.actuators(),
+            exact_balance: Default::default(),
         }
     }
 
@@ -854,6 +858,90 @@ mod tests {
         }
     }
 
+    /// The exact flow S2 (Taylor sums on the balanced blocks, each account's energy from the
+    /// momentum rows of the Hilbert Gramian) against the unbalanced system's matrix exponential
+    /// and Van Loan Gramian (nalgebra's Padé approximant on the 10×10 and 20×20 matrices), at
+    /// attitudes far from the upright one where the balance was computed, with the controller
+    /// on and off, for steps from one Taylor piece to the Padé fallback and backwards.
+    #[test]
+    fn the_exact_flow_s2_is_the_matrix_exponential_with_the_van_loan_ledger() {
+        use crate::flows::affine;
+        use nalgebra::{SMatrix, SVector};
+        let v = with_external("body");
+        let sys = VesselSystem::new(&v, Some(0.0));
+        let minv = sys.minv();
+        let seeds = [
+            [0.3, -0.2, 0.5, 0.1, -0.7, 0.2, 0.4, -0.1],
+            [-0.9, 0.8, -1.0, 0.8, 0.3, -0.5, 0.9, 0.2],
+            [1.0, 1.0, 0.9, -1.0, 1.0, 1.0, -1.0, 1.0],
+        ];
+        for seed in seeds {
+            for on in [true, false] {
+                for h in [0.01, 0.5, 3.0, -0.25, 40.0] {
+                    let s0 = random_state(&v, seed);
+                    let fr = sys.frozen(&s0, on);
+                    let b = sys.s2_of(&fr, true);
+                    let z0 = sys.blocks_of(&s0);
+                    let (z1, work) = sys.exact_s2(&b, &z0, h, on);
+                    let mut expected = vec![0.0; sys.accounts().len()];
+                    for k in 0..2 {
+                        // The structural balance only (diagonal, powers of two: exact), so
+                        // that the references see entries of comparable size.
+                        let d = s2::balance(&b.sys[k], &minv[k]);
+                        let aa = b.sys[k].augmented();
+                        let abar = SMatrix::<f64, 10, 10>::from_fn(|i, j| aa[(i, j)] * d[j] / d[i]);
+                        let mut z = SVector::<f64, 10>::zeros();
+                        for i in 0..3 {
+                            z.fixed_rows_mut::<3>(3 * i).copy_from(&z0[k][i]);
+                        }
+                        z[9] = 1.0;
+                        let z = z.component_div(&d);
+                        let (_, gram) = affine::flow_and_gramian::<10, 20>(&abar, &z, h);
+                        let gram =
+                            SMatrix::<f64, 10, 10>::from_fn(|i, j| gram[(i, j)] * d[i] * d[j]);
+                        // The flow against the double-double Taylor series (32 digits).
+                        let r = affine::tests::reference_action(&abar, &z, h);
+                        let r = SVector::<f64, 10>::from_fn(|i, _| r[i].hi * d[i]);
+                        for i in 0..3 {
+                            let got = z1[k][i];
+                            let want = r.fixed_rows::<3>(3 * i).into_owned();
+                            let err = (got - want).norm();
+                            assert!(
+                                err <= 1e-13 * want.norm().max(1e-300),
+                                "seed {seed:?} on {on} h {h} system {k} part {i}: {got} vs {want}"
+                            );
+                        }
+                        for (acc, rows) in b.booked.as_ref().unwrap().iter().enumerate() {
+                            let f = &rows[k];
+                            let mut rr = SMatrix::<f64, 3, 10>::zeros();
+                            rr.fixed_view_mut::<3, 3>(0, 0)
+                                .copy_from(&(f.fnu[k] * Matrix3::from_diagonal(&minv[k])));
+                            rr.fixed_view_mut::<3, 3>(0, 3).copy_from(&f.fv);
+                            rr.fixed_view_mut::<3, 3>(0, 6).copy_from(&f.fw);
+                            rr.fixed_view_mut::<3, 1>(0, 9).copy_from(&f.c);
+                            let mut p = SMatrix::<f64, 10, 10>::zeros();
+                            for i in 0..3 {
+                                for j in 0..10 {
+                                    p[(i, j)] += 0.5 * minv[k][i] * rr[(i, j)];
+                                    p[(j, i)] += 0.5 * minv[k][i] * rr[(i, j)];
+                                }
+                            }
+                            expected[acc] += sys.sign(acc) * affine::trace_product(&p, &gram);
+                        }
+                    }
+                    let size: f64 = expected.iter().map(|x| x.abs()).sum::<f64>() + v.energy(&s0);
+                    for (acc, (got, want)) in work.0.iter().zip(&expected).enumerate() {
+                        assert!(
+                            (got - want).abs() <= 1e-10 * size,
+                            "seed {seed:?} on {on} h {h} account {}: {got} vs {want}",
+                            sys.accounts()[acc].name
+                        );
+                    }
+                }
+            }
+        }
+    }
+
     /// The forced collocation (dense stage solve, forcing iterated) against the structured
     /// affine one: a set-point table whose only row is the fixed set point adds a forcing that
     /// is identically zero, so both must give the same flow and ledger to round-off.
@@ -1029,7 +1117,7 @@ mod tests {
                 assert!(b.cross.is_none());
                 let z0 = sys.blocks_of(&s0);
                 let (za, wa) = match lf {
-                    LinearFlow::Exact => sys.exact_s2(&b, &z0, h),
+                    LinearFlow::Exact => sys.exact_s2(&b, &z0, h, true),
                     LinearFlow::Gauss => sys.gauss_s2(&b, &z0, h, stages),
                 };
                 b.cross = Some([[Matrix3::zeros(); 3]; 2]);

@@ -50,7 +50,7 @@ impl VesselSystem<'_> {
         } else {
             match self.linear {
                 LinearFlow::Gauss => self.gauss_s2(&b, &z0, h, stages),
-                LinearFlow::Exact => self.exact_s2(&b, &z0, h),
+                LinearFlow::Exact => self.exact_s2(&b, &z0, h, fr.control_on),
             }
         };
         self.set_blocks(s, &z1);
@@ -85,37 +85,89 @@ impl VesselSystem<'_> {
         ([zt1, zr1], work)
     }
 
+    /// The balance of the exact flow's block systems beyond [`balance`]'s structural one, per
+    /// controller state (`[on][system]`): Osborne's balance ([`affine::balance`]) of the blocks
+    /// at the upright attitude, as factors on the structural scale. It depends on the vessel
+    /// alone, so it is computed once, and a run does not depend on which sub-steps came before.
+    /// At other attitudes the same factors are a similarity still (exact), and only the Taylor
+    /// sum's degree can change.
+    pub(super) fn exact_balance(&self) -> &[[SVector<f64, 10>; 2]; 2] {
+        self.exact_balance.get_or_init(|| {
+            let minv = self.minv();
+            std::array::from_fn(|on| {
+                let b = self.s2_at(&Matrix3::identity(), on == 1, false);
+                std::array::from_fn(|k| {
+                    let structural = balance(&b.sys[k], &minv[k]);
+                    let inv = structural.map(|v| 1.0 / v);
+                    let abar = b.sys[k].augmented();
+                    let mut a = SMatrix::<f64, 10, 10>::from_fn(|i, j| {
+                        abar[(i, j)] * structural[j] * inv[i]
+                    });
+                    let mut factors = SVector::<f64, 10>::from_element(1.0);
+                    affine::balance(&mut a, &mut factors);
+                    factors
+                })
+            })
+        })
+    }
+
     /// The exact flow of both block systems, balanced; with the ledger, each account's energy
     /// from one Gramian per system.
-    pub(super) fn exact_s2(&self, b: &S2Builder, z0: &[Z3; 2], h: f64) -> ([Z3; 2], Work) {
+    pub(super) fn exact_s2(
+        &self,
+        b: &S2Builder,
+        z0: &[Z3; 2],
+        h: f64,
+        on: bool,
+    ) -> ([Z3; 2], Work) {
+        let on = on as usize;
         let minv = self.minv();
         let mut z1 = [[Vector3::zeros(); 3]; 2];
         let mut work = Work::default();
         for sys in [Sys::Trans, Sys::Rot] {
             let k = sys as usize;
             let blocks = &b.sys[k];
-            let scale = balance(blocks, &minv[k]);
+            let mut scale = balance(blocks, &minv[k]).component_mul(&self.exact_balance()[on][k]);
             let inv = scale.map(|v| 1.0 / v);
             let abar = blocks.augmented();
-            let a = SMatrix::<f64, 10, 10>::from_fn(|i, j| abar[(i, j)] * scale[j] * inv[i]);
+            let mut a = SMatrix::<f64, 10, 10>::from_fn(|i, j| abar[(i, j)] * scale[j] * inv[i]);
             let mut zz = SVector::<f64, 10>::zeros();
             for (i, v) in z0[k].iter().enumerate() {
                 zz.fixed_rows_mut::<3>(3 * i).copy_from(v);
             }
             zz[9] = 1.0;
+            affine::balance_constant(&mut a, &mut scale, &zz);
             let zb = zz.component_div(&scale);
+            // The product with the balanced blocks (the similarity keeps their zeros).
+            let bal = Blocks::from_augmented(&a);
+            let apply = |x: &SVector<f64, 10>, c: f64| match &bal {
+                Some(bl) => block_product(bl, x, c),
+                None => affine::matvec(&a, x, c),
+            };
             let zb1 = match &b.booked {
                 Some(booked) => {
-                    let (f, gram) = affine::flow_and_gramian::<10, 20>(&a, &zb, h);
+                    let (zb1, gram) = affine::flow_action_and_gramian_rows_by::<10, 3, 20>(
+                        &a,
+                        &apply,
+                        &zb,
+                        h,
+                        &[0, 1, 2],
+                    );
                     for acc in 0..self.accounts.len() {
-                        let m = power_form(&booked[acc][k], &minv[k], k);
-                        let mb =
-                            SMatrix::<f64, 10, 10>::from_fn(|i, j| m[(i, j)] * scale[i] * scale[j]);
-                        work.0[acc] += self.sign(acc) * affine::trace_product(&mb, &gram);
+                        let r = power_rows(&booked[acc][k], &minv[k], k);
+                        let energy = (0..10)
+                            .map(|j| {
+                                (0..3)
+                                    .map(|i| r[(i, j)] * scale[i] * gram[(i, j)])
+                                    .sum::<f64>()
+                                    * scale[j]
+                            })
+                            .sum::<f64>();
+                        work.0[acc] += self.sign(acc) * energy;
                     }
-                    f * zb
+                    zb1
                 }
-                None => affine::flow(&a, h) * zb,
+                None => affine::flow_action_by(&a, apply, &zb, h),
             };
             let z = zb1.component_mul(&scale);
             z1[k] = [
@@ -253,14 +305,14 @@ fn relative_change(r: &[f64], y: &[f64], n: usize) -> (f64, f64) {
 /// of `A_vu M` (exact in floating point), the rest by 1. The entries of `S⁻¹ Ā S` are then of
 /// comparable size, instead of spanning fifteen orders of magnitude; without it the ledger
 /// closed only to about 1e-6 J.
-fn balance(b: &Blocks, minv: &Vector3<f64>) -> SVector<f64, 10> {
+pub(super) fn balance(b: &Blocks, minv: &Vector3<f64>) -> SVector<f64, 10> {
     let su = minv.map(|v| 1.0 / v);
     let avu_m = b.avu * Matrix3::from_diagonal(&su);
     let norm = (0..3)
         .map(|i| avu_m.row(i).iter().map(|v| v.abs()).sum::<f64>())
         .fold(0.0, f64::max);
-    let sv = if norm > 0.0 && norm.is_finite() {
-        2f64.powi(norm.log2().round() as i32)
+    let sv = if norm.is_normal() {
+        affine::nearest_power_of_two(norm)
     } else {
         1.0
     };
@@ -271,9 +323,27 @@ fn balance(b: &Blocks, minv: &Vector3<f64>) -> SVector<f64, 10> {
     })
 }
 
-/// The quadratic form of the power of a force: `νᵀ F z̄`, symmetrised, on `z̄ = (u, v, w, 1)`
-/// of system `k`, with `ν = M⁻¹u` (`M` of the paper's form: diagonal `minv` on this system).
-fn power_form(f: &Rows, minv: &Vector3<f64>, k: usize) -> SMatrix<f64, 10, 10> {
+/// `c Ā z̄` for the augmented block system `Ā` of `blocks` (its 45 nonzero 3×3 products
+/// instead of the dense 100).
+fn block_product(bl: &Blocks, z: &SVector<f64, 10>, c: f64) -> SVector<f64, 10> {
+    let u = z.fixed_rows::<3>(0);
+    let v = z.fixed_rows::<3>(3);
+    let w = z.fixed_rows::<3>(6);
+    let one = z[9];
+    let mut out = SVector::<f64, 10>::zeros();
+    out.fixed_rows_mut::<3>(0)
+        .copy_from(&((bl.auu * u + bl.auv * v + bl.auw * w + bl.cu * one) * c));
+    out.fixed_rows_mut::<3>(3).copy_from(&((bl.avu * u) * c));
+    out.fixed_rows_mut::<3>(6)
+        .copy_from(&((bl.awv * v + bl.cw * one) * c));
+    out
+}
+
+/// The power of a force, `νᵀ F z̄ = Σ R ∘ (ū z̄ᵀ)`, as the rows `R = diag(M⁻¹) F` on
+/// `z̄ = (u, v, w, 1)` of system `k`, with `ν = M⁻¹u` (`M` of the paper's form: diagonal `minv`
+/// on this system). Its integral along S2 is `Σ R ∘ Y` with `Y` the momentum rows of the
+/// Gramian.
+fn power_rows(f: &Rows, minv: &Vector3<f64>, k: usize) -> SMatrix<f64, 3, 10> {
     let mut r = SMatrix::<f64, 3, 10>::zeros();
     r.fixed_view_mut::<3, 3>(0, 0)
         .copy_from(&(f.fnu[k] * Matrix3::from_diagonal(minv)));
@@ -283,8 +353,5 @@ fn power_form(f: &Rows, minv: &Vector3<f64>, k: usize) -> SMatrix<f64, 10, 10> {
     for i in 0..3 {
         r.row_mut(i).scale_mut(minv[i]);
     }
-    let mut m = SMatrix::<f64, 10, 10>::zeros();
-    m.fixed_view_mut::<3, 10>(0, 0).copy_from(&(r * 0.5));
-    let mt = m.transpose();
-    m + mt
+    r
 }

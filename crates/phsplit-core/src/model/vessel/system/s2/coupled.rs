@@ -20,6 +20,9 @@ use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 type Full = SMatrix<f64, 19, 19>;
 type FullVector = SVector<f64, 19>;
 
+/// The momentum entries `u_t`, `u_r` of `z̄`.
+const MOMENTA: [usize; 6] = [0, 1, 2, 9, 10, 11];
+
 /// Flow S2 as one augmented matrix `Ā` on `z̄ = (u_t, v_t, w_t, u_r, v_r, w_r, 1)`: the two
 /// block systems on the diagonal and, when they are coupled, what each takes from the other's
 /// momentum.
@@ -173,11 +176,12 @@ impl VesselSystem<'_> {
         out
     }
 
-    /// The quadratic form of an account's power `Σ_k ν_kᵀ f_k` on `z̄`, symmetrised, with
-    /// `ν = M⁻¹u` through the full `M⁻¹`.
-    fn power_form_full(&self, rows: &[Rows; 2]) -> Full {
+    /// An account's power `Σ_k ν_kᵀ f_k = Σ R ∘ (z̄_U z̄ᵀ)` as rows `R` on the momentum entries
+    /// `U` ([`MOMENTA`]) of `z̄`, with `ν = M⁻¹u` through the full `M⁻¹`. Its integral along S2 is
+    /// `Σ R ∘ Y` with `Y` the rows `U` of the Gramian.
+    fn power_rows_full(&self, rows: &[Rows; 2]) -> SMatrix<f64, 6, 19> {
         let mi = &self.vessel.body.minv_blocks;
-        // ν = E z̄.
+        // ν = E z̄ = E_U z̄_U.
         let mut e = SMatrix::<f64, 6, 19>::zeros();
         for j in 0..2 {
             for l in 0..2 {
@@ -196,8 +200,8 @@ impl VesselSystem<'_> {
             c += f.c;
             r.fixed_view_mut::<3, 19>(3 * k, 0).copy_from(&rk);
         }
-        let m = e.transpose() * r * 0.5;
-        m + m.transpose()
+        let e_u = SMatrix::<f64, 6, 6>::from_fn(|i, j| e[(i, MOMENTA[j])]);
+        e_u.transpose() * r
     }
 
     /// Flow S2 where translation and rotation are coupled (a general mass matrix, or a force
@@ -223,9 +227,11 @@ impl VesselSystem<'_> {
         self.coupled_collocation(fr, b, z0, &scale, h, t, s)
     }
 
-    /// The exact flow of [`Self::coupled_s2`], balanced by `scale`, with each account's energy
-    /// from the Van Loan Gramian. Kept out of line: its 38×38 temporaries would otherwise make
-    /// every collocated sub-step pay for a stack frame of a few hundred kilobytes.
+    /// The exact flow of [`Self::coupled_s2`], balanced by `scale` and then by Osborne's
+    /// iteration ([`affine::balance`]), with each account's energy from the momentum rows of the
+    /// Gramian ([`affine::flow_action_and_gramian_rows`]). Kept out of line: its fallback's 38×38
+    /// temporaries would otherwise make every collocated sub-step pay for a stack frame of a few
+    /// hundred kilobytes.
     #[inline(never)]
     fn coupled_exact(
         &self,
@@ -236,22 +242,34 @@ impl VesselSystem<'_> {
     ) -> ([Z3; 2], Work) {
         let inv = scale.map(|v| 1.0 / v);
         let abar = augmented(b);
-        let a = Full::from_fn(|i, j| abar[(i, j)] * scale[j] * inv[i]);
-        let zb0 = pack_full(z0, 1.0).component_mul(&inv);
+        let mut a = Full::from_fn(|i, j| abar[(i, j)] * scale[j] * inv[i]);
+        let mut scale = *scale;
+        affine::balance(&mut a, &mut scale);
+        let z = pack_full(z0, 1.0);
+        affine::balance_constant(&mut a, &mut scale, &z);
+        let zb0 = z.component_div(&scale);
         let mut work = Work::default();
         let zb1 = match &b.booked {
             Some(booked) => {
-                let (f, gram) = affine::flow_and_gramian::<19, 38>(&a, &zb0, h);
+                let (zb1, gram) =
+                    affine::flow_action_and_gramian_rows::<19, 6, 38>(&a, &zb0, h, &MOMENTA);
                 for acc in 0..self.accounts.len() {
-                    let m = self.power_form_full(&booked[acc]);
-                    let mb = Full::from_fn(|i, j| m[(i, j)] * scale[i] * scale[j]);
-                    work.0[acc] += self.sign(acc) * affine::trace_product(&mb, &gram);
+                    let r = self.power_rows_full(&booked[acc]);
+                    let energy = (0..19)
+                        .map(|j| {
+                            (0..6)
+                                .map(|i| r[(i, j)] * scale[MOMENTA[i]] * gram[(i, j)])
+                                .sum::<f64>()
+                                * scale[j]
+                        })
+                        .sum::<f64>();
+                    work.0[acc] += self.sign(acc) * energy;
                 }
-                f * zb0
+                zb1
             }
-            None => affine::flow(&a, h) * zb0,
+            None => affine::flow_action(&a, &zb0, h),
         };
-        (unpack_full(&zb1.component_mul(scale)), work)
+        (unpack_full(&zb1.component_mul(&scale)), work)
     }
 
     /// Gauss collocation with `s` stages of flow S2, coupled or not, with its forcing part:
