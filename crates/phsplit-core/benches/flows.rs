@@ -56,7 +56,9 @@ fn flows(c: &mut Criterion) {
         }
     }
     // One step of every method, measured as 1,000 steps (h = 0.05 s, where every method is
-    // stable, forward Euler included) with decimated saving.
+    // stable, forward Euler included) with decimated saving and the default projection onto
+    // the restoring invariant (so no sub-steps merge across steps); the splitting methods also
+    // with the ledger.
     for name in names() {
         let method: Method = name.parse().unwrap();
         let variants: &[LinearFlow] = match method {
@@ -82,6 +84,16 @@ fn flows(c: &mut Criterion) {
             c.bench_function(&label, |b| {
                 b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
             });
+            // With the ledger (issue 17's measure of a step: every account booked).
+            if let Method::Splitting(_) = method {
+                let opts = Options {
+                    ledger: true,
+                    ..opts
+                };
+                c.bench_function(&format!("{label} + ledger"), |b| {
+                    b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
+                });
+            }
         }
     }
 }

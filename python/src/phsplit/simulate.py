@@ -1,6 +1,7 @@
 """The user-facing simulation API: :class:`Vessel`, :func:`simulate`, :class:`Solution`."""
 from __future__ import annotations
 
+import copy
 import math
 import os
 import warnings
@@ -38,11 +39,23 @@ class Vessel:
     mapping (``to_dict()`` gives them back, with defaults filled in).
     """
 
-    __slots__ = ("_inner", "source")
+    __slots__ = ("_inner", "source", "_derived")
 
     def __init__(self, inner: _core.Vessel, source: str = "") -> None:
         self._inner = inner
         self.source = source
+        # What every run asks of the vessel (its TOML text, body, mass matrix, components,
+        # natural periods), computed once: a vessel does not change after it is built.
+        self._derived: dict[Any, Any] = {}
+
+    def _once(self, key: Any, make):
+        try:
+            derived = self._derived
+        except AttributeError:  # unpickled from a phsplit without the slot
+            derived = self._derived = {}
+        if key not in derived:
+            derived[key] = make()
+        return derived[key]
 
     @classmethod
     def paper(cls) -> "Vessel":
@@ -90,18 +103,28 @@ class Vessel:
 
     def to_toml(self) -> str:
         """Every parameter as TOML text; ``Vessel.from_toml_str`` rebuilds this vessel exactly."""
-        return self._inner.to_toml()
+        return self._once("toml", self._inner.to_toml)
 
     @property
     def components(self) -> list[str]:
         """The vessel's force components (ports), in the order they are assembled."""
-        return self._inner.components()
+        return list(self._once("components", self._inner.components))
 
     @property
     def mass_matrix(self) -> np.ndarray:
         """The 6x6 mass matrix ``M = M_RB + M_A`` (body frame, z up; kg, kg m, kg m^2 blocks):
         the momenta are ``(p, m) = M nu`` (docs/model.md §5.14)."""
-        return np.asarray(self._inner.mass_matrix(), dtype=float)
+        return self._once("mass_matrix", lambda: np.asarray(self._inner.mass_matrix(), dtype=float)).copy()
+
+    def _body(self) -> tuple[Any, Any]:
+        """The ``[vessel]`` table's mass and inertia (fresh copies)."""
+        mass, inertia = self._once("body", lambda: (lambda b: (b["mass"], b["inertia"]))(self.to_dict()["vessel"]))
+        return mass, ([list(r) if isinstance(r, list) else r for r in inertia] if isinstance(inertia, list)
+                      else copy.deepcopy(inertia))
+
+    def _natural_periods_at(self, state: np.ndarray, control: bool) -> list[float]:
+        key = ("periods", np.asarray(state, dtype=float).tobytes(), bool(control))
+        return list(self._once(key, lambda: self._inner.natural_periods(state, bool(control))))
 
     def natural_periods(self, control: bool = True, **initial: Sequence[float]) -> list[float]:
         """The natural periods (s, ascending) of the vessel's oscillating modes, flow S2
@@ -495,9 +518,11 @@ def _warn_if_step_too_long(vessel: "Vessel", y0: np.ndarray, settings: "Settings
     vessel (flow S2 linearised at the initial attitude, with the controller as it will act):
     fewer than two steps per period cannot represent that oscillation."""
     try:
-        h = float(settings.checked()["h"])
+        h = float(settings.h)
+        if not (math.isfinite(h) and h > 0.0):
+            return  # the core refuses it, by name, when the run starts
         state = vessel.initial_state() if y0 is None else y0
-        periods = vessel._inner.natural_periods(state, settings.control_start is not None)
+        periods = vessel._natural_periods_at(state, settings.control_start is not None)
     except (_core.InvalidInputError, ValueError, TypeError):
         return  # the core reports bad input when the run starts
     if periods and h > 0.5 * periods[0]:
@@ -536,9 +561,9 @@ class Settings:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
         if d["control_start"] is None:
             d["control_start"] = "never"
-        what = dict(_core.settings_keys())
         for k, v in d.items():
             if v is None:
+                what = dict(_core.settings_keys())
                 raise _core.InvalidInputError(f"{k} must be given ({what.get(k, 'a value')}), got None")
             if isinstance(v, np.bool_):
                 d[k] = bool(v)
@@ -682,7 +707,7 @@ def simulate(
     info = _core.method_info(used["method"])
     if used["ledger"] and info["kind"] == "splitting" and not info["all_positive"] and len(e) > 1:
         _warn_if_energy_created(raw, info, used["outer"], e)
-    body = vessel.to_dict()["vessel"]
+    mass, inertia = vessel._body()
     names = list(raw["accounts"])
     sol = Solution(
         t=raw["t"], x=raw["x"], euler=raw["euler"], quaternion=raw["quaternion"], Q=raw["Q"],
@@ -694,7 +719,7 @@ def simulate(
         orthogonality_defect=raw["orthogonality_defect"], status=raw["status"],
         method=info["name"], h=used["h"], control_start=used["control_start"], steps=raw["steps"],
         failure=raw.get("failure"), last_good_state=raw["last_good"],
-        meta={"mass": body["mass"], "inertia": body["inertia"], "mass_matrix": vessel.mass_matrix,
+        meta={"mass": mass, "inertia": inertia, "mass_matrix": vessel.mass_matrix,
               "t_last_good": raw["t_last_good"],
               "components": vessel.components},
         account_force=raw["account_force"], account_moment=raw["account_moment"], settings=dict(used),
