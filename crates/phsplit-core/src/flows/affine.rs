@@ -81,7 +81,7 @@ pub fn taylor_pieces(theta: f64) -> Option<usize> {
 /// has a zero constant entry, so `Ā` acts on them as `A`, and the remainder bound and the
 /// cancellation in the sum depend on `A` alone. A matrix whose last row is not zero (not
 /// augmented) counts all its columns.
-fn taylor_norm1_times<const N: usize>(abar: &SMatrix<f64, N, N>, h: f64) -> f64 {
+pub fn taylor_norm1_times<const N: usize>(abar: &SMatrix<f64, N, N>, h: f64) -> f64 {
     let augmented = abar.row(N - 1).iter().all(|v| *v == 0.0);
     let cols = if augmented { N - 1 } else { N };
     (0..cols)
@@ -100,17 +100,24 @@ pub fn balance_constant<const N: usize>(
     scale: &mut SVector<f64, N>,
     z: &SVector<f64, N>,
 ) {
+    if let Some(f) = constant_factor(scale, z) {
+        abar.column_mut(N - 1).scale_mut(f);
+        scale[N - 1] *= f;
+    }
+}
+
+/// The power of two [`balance_constant`] multiplies the constant coordinate's scale (and the
+/// forcing column) by, if any.
+pub fn constant_factor<const N: usize>(scale: &SVector<f64, N>, z: &SVector<f64, N>) -> Option<f64> {
     let gamma = (0..N - 1)
         .map(|i| (z[i] / scale[i]).abs())
         .fold(0.0, f64::max);
     let g = (z[N - 1] / scale[N - 1]).abs() / gamma;
     if !(g.is_normal() && gamma.is_normal()) {
-        return;
+        return None;
     }
     let e = ((g.to_bits() >> 52) & 0x7ff) as i64 - 1023;
-    let f = f64::from_bits(((e + 1023) as u64) << 52);
-    abar.column_mut(N - 1).scale_mut(f);
-    scale[N - 1] *= f;
+    Some(f64::from_bits(((e + 1023) as u64) << 52))
 }
 
 /// `‖Ā‖₁ |h|`: the largest column sum.
@@ -184,23 +191,26 @@ pub fn flow_action<const N: usize>(
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>>,
 {
-    flow_action_by(abar, |x, c| matvec(abar, x, c), z0, h)
+    let norm1 = taylor_norm1_times(abar, 1.0);
+    flow_action_by(norm1, |x, c| matvec(abar, x, c), || *abar, z0, h)
 }
 
-/// [`flow_action`] with `apply(x, c) = c Ā x` computed by the caller (a structured product;
-/// `abar` gives the norm and the fallback).
+/// [`flow_action`] with the operator given by the caller: `apply(x, c) = c Ā x` (a structured
+/// product), `norm1 = ‖A‖₁` as [`taylor_norm1_times`] measures it (per unit time), and `dense`,
+/// which builds `Ā` only for the fallback.
 pub fn flow_action_by<const N: usize>(
-    abar: &SMatrix<f64, N, N>,
+    norm1: f64,
     apply: impl Fn(&SVector<f64, N>, f64) -> SVector<f64, N>,
+    dense: impl FnOnce() -> SMatrix<f64, N, N>,
     z0: &SVector<f64, N>,
     h: f64,
 ) -> SVector<f64, N>
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>>,
 {
-    let theta = taylor_norm1_times(abar, h);
+    let theta = norm1 * h.abs();
     let Some(pieces) = taylor_pieces(theta) else {
-        return flow(abar, h) * z0;
+        return flow(&dense(), h) * z0;
     };
     let tau = h / pieces as f64;
     let rho = theta / pieces as f64;
@@ -228,13 +238,23 @@ pub fn flow_action_and_gramian_rows<const N: usize, const R: usize, const N2: us
 where
     Const<N2>: DimMin<Const<N2>, Output = Const<N2>>,
 {
-    flow_action_and_gramian_rows_by::<N, R, N2>(abar, |x, c| matvec(abar, x, c), z0, h, rows)
+    let norm1 = taylor_norm1_times(abar, 1.0);
+    flow_action_and_gramian_rows_by::<N, R, N2>(
+        norm1,
+        |x, c| matvec(abar, x, c),
+        || *abar,
+        z0,
+        h,
+        rows,
+    )
 }
 
-/// [`flow_action_and_gramian_rows`] with `apply(x, c) = c Ā x` computed by the caller.
+/// [`flow_action_and_gramian_rows`] with the operator given by the caller, as for
+/// [`flow_action_by`].
 pub fn flow_action_and_gramian_rows_by<const N: usize, const R: usize, const N2: usize>(
-    abar: &SMatrix<f64, N, N>,
+    norm1: f64,
     apply: impl Fn(&SVector<f64, N>, f64) -> SVector<f64, N>,
+    dense: impl FnOnce() -> SMatrix<f64, N, N>,
     z0: &SVector<f64, N>,
     h: f64,
     rows: &[usize; R],
@@ -242,9 +262,10 @@ pub fn flow_action_and_gramian_rows_by<const N: usize, const R: usize, const N2:
 where
     Const<N2>: DimMin<Const<N2>, Output = Const<N2>>,
 {
-    let theta = taylor_norm1_times(abar, h);
+    let theta = norm1 * h.abs();
     let Some(pieces) = taylor_pieces(theta) else {
-        let (f, z) = flow_and_gramian::<N, N2>(abar, z0, h);
+        let abar = dense();
+        let (f, z) = flow_and_gramian::<N, N2>(&abar, z0, h);
         return (f * z0, SMatrix::from_fn(|r, j| z[(rows[r], j)]));
     };
     let tau = h / pieces as f64;

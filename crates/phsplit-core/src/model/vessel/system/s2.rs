@@ -128,46 +128,42 @@ impl VesselSystem<'_> {
             let k = sys as usize;
             let blocks = &b.sys[k];
             let mut scale = balance(blocks, &minv[k]).component_mul(&self.exact_balance()[on][k]);
-            let inv = scale.map(|v| 1.0 / v);
-            let abar = blocks.augmented();
-            let mut a = SMatrix::<f64, 10, 10>::from_fn(|i, j| abar[(i, j)] * scale[j] * inv[i]);
             let mut zz = SVector::<f64, 10>::zeros();
             for (i, v) in z0[k].iter().enumerate() {
                 zz.fixed_rows_mut::<3>(3 * i).copy_from(v);
             }
             zz[9] = 1.0;
-            affine::balance_constant(&mut a, &mut scale, &zz);
+            if let Some(f) = affine::constant_factor(&scale, &zz) {
+                scale[9] *= f;
+            }
             let zb = zz.component_div(&scale);
-            // The product with the balanced blocks (the similarity keeps their zeros).
-            let bal = Blocks::from_augmented(&a);
-            let apply = |x: &SVector<f64, 10>, c: f64| match &bal {
-                Some(bl) => block_product(bl, x, c),
-                None => affine::matvec(&a, x, c),
-            };
+            // The balanced system in its blocks: the products, the norm, and the dense matrix
+            // only for the fallback.
+            let bal = blocks.scaled(&scale);
+            let norm1 = bal.dynamics_norm1();
+            let apply = |x: &SVector<f64, 10>, c: f64| bal.apply_augmented(x, c);
+            let dense = || bal.augmented();
             let zb1 = match &b.booked {
                 Some(booked) => {
                     let (zb1, gram) = affine::flow_action_and_gramian_rows_by::<10, 3, 20>(
-                        &a,
-                        &apply,
+                        norm1,
+                        apply,
+                        dense,
                         &zb,
                         h,
                         &[0, 1, 2],
                     );
+                    // The momentum rows of the Gramian in the vessel's coordinates.
+                    let gram = SMatrix::<f64, 3, 10>::from_fn(|i, j| {
+                        gram[(i, j)] * scale[i] * scale[j]
+                    });
                     for acc in 0..self.accounts.len() {
                         let r = power_rows(&booked[acc][k], &minv[k], k);
-                        let energy = (0..10)
-                            .map(|j| {
-                                (0..3)
-                                    .map(|i| r[(i, j)] * scale[i] * gram[(i, j)])
-                                    .sum::<f64>()
-                                    * scale[j]
-                            })
-                            .sum::<f64>();
-                        work.0[acc] += self.sign(acc) * energy;
+                        work.0[acc] += self.sign(acc) * r.component_mul(&gram).sum();
                     }
                     zb1
                 }
-                None => affine::flow_action_by(&a, apply, &zb, h),
+                None => affine::flow_action_by(norm1, apply, dense, &zb, h),
             };
             let z = zb1.component_mul(&scale);
             z1[k] = [
@@ -321,22 +317,6 @@ pub(super) fn balance(b: &Blocks, minv: &Vector3<f64>) -> SVector<f64, 10> {
         3..=5 => sv,
         _ => 1.0,
     })
-}
-
-/// `c Ā z̄` for the augmented block system `Ā` of `blocks` (its 45 nonzero 3×3 products
-/// instead of the dense 100).
-fn block_product(bl: &Blocks, z: &SVector<f64, 10>, c: f64) -> SVector<f64, 10> {
-    let u = z.fixed_rows::<3>(0);
-    let v = z.fixed_rows::<3>(3);
-    let w = z.fixed_rows::<3>(6);
-    let one = z[9];
-    let mut out = SVector::<f64, 10>::zeros();
-    out.fixed_rows_mut::<3>(0)
-        .copy_from(&((bl.auu * u + bl.auv * v + bl.auw * w + bl.cu * one) * c));
-    out.fixed_rows_mut::<3>(3).copy_from(&((bl.avu * u) * c));
-    out.fixed_rows_mut::<3>(6)
-        .copy_from(&((bl.awv * v + bl.cw * one) * c));
-    out
 }
 
 /// The power of a force, `νᵀ F z̄ = Σ R ∘ (ū z̄ᵀ)`, as the rows `R = diag(M⁻¹) F` on
