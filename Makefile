@@ -55,6 +55,7 @@ bench: $(VENV)/.built $(VENV)/.bench-deps
 	$(BIN)/python benchmarks/work_precision.py
 	PHSPLIT_BENCH_PROJECT=1 $(BIN)/python benchmarks/work_precision.py --out benchmarks/results/projected
 	$(BIN)/python benchmarks/sweep_throughput.py
+	$(BIN)/python benchmarks/sweep_throughput.py --linear-flow exact
 	$(BIN)/python benchmarks/weather_stability.py
 	$(BIN)/python benchmarks/general_vessel.py
 	$(BIN)/python benchmarks/fmu_speed.py
