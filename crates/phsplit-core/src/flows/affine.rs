@@ -108,7 +108,10 @@ pub fn balance_constant<const N: usize>(
 
 /// The power of two [`balance_constant`] multiplies the constant coordinate's scale (and the
 /// forcing column) by, if any.
-pub fn constant_factor<const N: usize>(scale: &SVector<f64, N>, z: &SVector<f64, N>) -> Option<f64> {
+pub fn constant_factor<const N: usize>(
+    scale: &SVector<f64, N>,
+    z: &SVector<f64, N>,
+) -> Option<f64> {
     let gamma = (0..N - 1)
         .map(|i| (z[i] / scale[i]).abs())
         .fold(0.0, f64::max);
@@ -118,6 +121,27 @@ pub fn constant_factor<const N: usize>(scale: &SVector<f64, N>, z: &SVector<f64,
     }
     let e = ((g.to_bits() >> 52) & 0x7ff) as i64 - 1023;
     Some(f64::from_bits(((e + 1023) as u64) << 52))
+}
+
+/// For the matrix-exponential fallback: an augmented system whose constant coordinate holds
+/// `c ≠ 1` (a balance of the constant, [`balance_constant`]) written again with that coordinate
+/// at 1 (the forcing column times `c`): `(Ā', z', c)`. Scaling and squaring sizes its steps by
+/// the whole matrix's norm, so a forcing column scaled up to a small state would make it drown
+/// the dynamics in rounding. A system that is not augmented, or whose constant is 0 or not
+/// finite, is returned as it is (`c = 1`).
+fn unit_constant<const N: usize>(
+    mut abar: SMatrix<f64, N, N>,
+    z0: &SVector<f64, N>,
+) -> (SMatrix<f64, N, N>, SVector<f64, N>, f64) {
+    let c = z0[N - 1];
+    let augmented = abar.row(N - 1).iter().all(|v| *v == 0.0);
+    if !augmented || !c.is_normal() {
+        return (abar, *z0, 1.0);
+    }
+    abar.column_mut(N - 1).scale_mut(c);
+    let mut z = *z0;
+    z[N - 1] = 1.0;
+    (abar, z, c)
 }
 
 /// `‖Ā‖₁ |h|`: the largest column sum.
@@ -210,7 +234,10 @@ where
 {
     let theta = norm1 * h.abs();
     let Some(pieces) = taylor_pieces(theta) else {
-        return flow(&dense(), h) * z0;
+        let (abar, z, c) = unit_constant(dense(), z0);
+        let mut z1 = flow(&abar, h) * z;
+        z1[N - 1] *= c;
+        return z1;
     };
     let tau = h / pieces as f64;
     let rho = theta / pieces as f64;
@@ -264,9 +291,16 @@ where
 {
     let theta = norm1 * h.abs();
     let Some(pieces) = taylor_pieces(theta) else {
-        let abar = dense();
-        let (f, z) = flow_and_gramian::<N, N2>(&abar, z0, h);
-        return (f * z0, SMatrix::from_fn(|r, j| z[(rows[r], j)]));
+        let (abar, z, c) = unit_constant(dense(), z0);
+        let (f, gram) = flow_and_gramian::<N, N2>(&abar, &z, h);
+        let mut z1 = f * z;
+        z1[N - 1] *= c;
+        // Back to the caller's constant coordinate: Z = D Z' D with D = diag(1, …, 1, c).
+        let d = |i: usize| if i == N - 1 { c } else { 1.0 };
+        return (
+            z1,
+            SMatrix::from_fn(|r, j| gram[(rows[r], j)] * d(rows[r]) * d(j)),
+        );
     };
     let tau = h / pieces as f64;
     let rho = theta / pieces as f64;
@@ -325,11 +359,16 @@ const SWEEPS: usize = 16;
 pub fn balance<const N: usize>(a: &mut SMatrix<f64, N, N>, scale: &mut SVector<f64, N>) {
     // The off-diagonal magnitudes (column-major, as `a`) and their column sums `c` and row sums
     // `r`, kept up to date as indices are scaled: no sum is a chain of dependent adds.
+    // An augmented matrix (last row zero) is balanced on its dynamics alone: the forcing column
+    // has no fixed size (the constant coordinate's scale is chosen per state, balance_constant)
+    // and must not steer the other indices' factors.
+    let augmented = a.row(N - 1).iter().all(|v| *v == 0.0);
     let s = a.as_mut_slice();
     let mut m = [[0.0; N]; N];
     for (j, col) in m.iter_mut().enumerate() {
         for (i, v) in col.iter_mut().enumerate() {
-            *v = if i == j { 0.0 } else { s[j * N + i].abs() };
+            let outside = i == j || (augmented && (i == N - 1 || j == N - 1));
+            *v = if outside { 0.0 } else { s[j * N + i].abs() };
         }
     }
     let mut c = [0.0; N];

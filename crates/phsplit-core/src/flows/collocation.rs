@@ -177,7 +177,11 @@ impl Blocks {
     pub fn scaled(&self, d: &SVector<f64, 10>) -> Self {
         let part = |o: usize| Vector3::new(d[o], d[o + 1], d[o + 2]);
         let (du, dv, dw) = (part(0), part(3), part(6));
-        let (iu, iv, iw) = (du.map(|x| 1.0 / x), dv.map(|x| 1.0 / x), dw.map(|x| 1.0 / x));
+        let (iu, iv, iw) = (
+            du.map(|x| 1.0 / x),
+            dv.map(|x| 1.0 / x),
+            dw.map(|x| 1.0 / x),
+        );
         let sim = |m: &Matrix3<f64>, rows: &Vector3<f64>, cols: &Vector3<f64>| {
             Matrix3::from_fn(|r, c| m[(r, c)] * cols[c] * rows[r])
         };
@@ -195,7 +199,8 @@ impl Blocks {
     /// `‖A‖₁` of the system without its forcing: the largest column sum of `|A|` over the
     /// columns of `u`, `v` and `w`.
     pub fn dynamics_norm1(&self) -> f64 {
-        let col = |m: &[&Matrix3<f64>], c: usize| m.iter().map(|b| b.column(c).abs().sum()).sum::<f64>();
+        let col =
+            |m: &[&Matrix3<f64>], c: usize| m.iter().map(|b| b.column(c).abs().sum()).sum::<f64>();
         (0..3)
             .map(|c| {
                 col(&[&self.auu, &self.avu], c)

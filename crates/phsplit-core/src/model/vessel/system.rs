@@ -875,10 +875,25 @@ mod tests {
             [-0.9, 0.8, -1.0, 0.8, 0.3, -0.5, 0.9, 0.2],
             [1.0, 1.0, 0.9, -1.0, 1.0, 1.0, -1.0, 1.0],
         ];
-        for seed in seeds {
+        // Three random states, and one at rest 1e-12 m from the set point, where a constant
+        // load dwarfs the state (a review found the fallback's exponential losing the dynamics
+        // there when the constant coordinate was scaled to the state: 2e-2 relative, h = 50 s).
+        let xr = param(&v, "control", "position_reference");
+        let near_rest = v.state_from(
+            Vector3::new(0.05, -0.02, 0.1),
+            xr + Vector3::new(1e-12, 0.0, 0.0),
+            Vector3::zeros(),
+            Vector3::zeros(),
+        );
+        let states: Vec<VesselState> = seeds
+            .iter()
+            .map(|seed| random_state(&v, *seed))
+            .chain([near_rest])
+            .collect();
+        for s0 in states {
+            let seed = s0.x;
             for on in [true, false] {
-                for h in [0.01, 0.5, 3.0, -0.25, 40.0] {
-                    let s0 = random_state(&v, seed);
+                for h in [0.01, 0.5, 3.0, -0.25, 20.0, 40.0] {
                     let fr = sys.frozen(&s0, on);
                     let b = sys.s2_of(&fr, true);
                     let z0 = sys.blocks_of(&s0);
@@ -906,8 +921,10 @@ mod tests {
                             let got = z1[k][i];
                             let want = r.fixed_rows::<3>(3 * i).into_owned();
                             let err = (got - want).norm();
+                            // h = 40 s is the Padé fallback: accurate in norm to 1e-12.
+                            let tol = if h.abs() > 30.0 { 1e-12 } else { 1e-13 };
                             assert!(
-                                err <= 1e-13 * want.norm().max(1e-300),
+                                err <= tol * want.norm().max(1e-300),
                                 "seed {seed:?} on {on} h {h} system {k} part {i}: {got} vs {want}"
                             );
                         }

@@ -154,9 +154,8 @@ impl VesselSystem<'_> {
                         &[0, 1, 2],
                     );
                     // The momentum rows of the Gramian in the vessel's coordinates.
-                    let gram = SMatrix::<f64, 3, 10>::from_fn(|i, j| {
-                        gram[(i, j)] * scale[i] * scale[j]
-                    });
+                    let gram =
+                        SMatrix::<f64, 3, 10>::from_fn(|i, j| gram[(i, j)] * scale[i] * scale[j]);
                     for acc in 0..self.accounts.len() {
                         let r = power_rows(&booked[acc][k], &minv[k], k);
                         work.0[acc] += self.sign(acc) * r.component_mul(&gram).sum();
