@@ -76,18 +76,36 @@ pub fn taylor_pieces(theta: f64) -> Option<usize> {
     (pieces <= MAX_PIECES as f64).then_some(pieces as usize)
 }
 
+/// Whether `Ā` is augmented: its last row (the constant coordinate's rate) is zero.
+fn is_augmented<const N: usize>(abar: &SMatrix<f64, N, N>) -> bool {
+    abar.row(N - 1).iter().all(|v| *v == 0.0)
+}
+
+/// The largest absolute column sum over the first `cols` columns.
+fn max_column_sum<const N: usize>(abar: &SMatrix<f64, N, N>, cols: usize) -> f64 {
+    (0..cols)
+        .map(|j| abar.column(j).iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// The binary exponent `e` of a positive normal `x` (`2^e ≤ x < 2^(e+1)`), from its bits.
+fn binary_exponent(x: f64) -> i64 {
+    ((x.to_bits() >> 52) & 0x7ff) as i64 - 1023
+}
+
+/// `2^e` for `−1022 ≤ e ≤ 1023`, exactly, from its bits.
+fn power_of_two(e: i64) -> f64 {
+    f64::from_bits(((e + 1023) as u64) << 52)
+}
+
 /// `ρ = ‖A‖₁ |h|` for the Taylor sum of an augmented `Ā = [[A, b], [0, 0]]`: the largest column
 /// sum of `A`'s columns. The forcing column does not count: every Taylor term after the first
 /// has a zero constant entry, so `Ā` acts on them as `A`, and the remainder bound and the
 /// cancellation in the sum depend on `A` alone. A matrix whose last row is not zero (not
 /// augmented) counts all its columns.
 pub fn taylor_norm1_times<const N: usize>(abar: &SMatrix<f64, N, N>, h: f64) -> f64 {
-    let augmented = abar.row(N - 1).iter().all(|v| *v == 0.0);
-    let cols = if augmented { N - 1 } else { N };
-    (0..cols)
-        .map(|j| abar.column(j).iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-        * h.abs()
+    let cols = if is_augmented(abar) { N - 1 } else { N };
+    max_column_sum(abar, cols) * h.abs()
 }
 
 /// For an augmented system balanced by `scale` (`z = scale ∘ z_b`), rescales its constant
@@ -119,8 +137,7 @@ pub fn constant_factor<const N: usize>(
     if !(g.is_normal() && gamma.is_normal()) {
         return None;
     }
-    let e = ((g.to_bits() >> 52) & 0x7ff) as i64 - 1023;
-    Some(f64::from_bits(((e + 1023) as u64) << 52))
+    Some(power_of_two(binary_exponent(g)))
 }
 
 /// For the matrix-exponential fallback: an augmented system whose constant coordinate holds
@@ -134,8 +151,7 @@ fn unit_constant<const N: usize>(
     z0: &SVector<f64, N>,
 ) -> (SMatrix<f64, N, N>, SVector<f64, N>, f64) {
     let c = z0[N - 1];
-    let augmented = abar.row(N - 1).iter().all(|v| *v == 0.0);
-    if !augmented || !c.is_normal() {
+    if !is_augmented(&abar) || !c.is_normal() {
         return (abar, *z0, 1.0);
     }
     abar.column_mut(N - 1).scale_mut(c);
@@ -146,10 +162,7 @@ fn unit_constant<const N: usize>(
 
 /// `‖Ā‖₁ |h|`: the largest column sum.
 fn norm1_times<const N: usize>(abar: &SMatrix<f64, N, N>, h: f64) -> f64 {
-    (0..N)
-        .map(|j| abar.column(j).iter().map(|v| v.abs()).sum::<f64>())
-        .fold(0.0, f64::max)
-        * h.abs()
+    max_column_sum(abar, N) * h.abs()
 }
 
 /// `c A x`, column by column.
@@ -331,15 +344,13 @@ where
 /// `2^round(log2 x)` for a positive normal `x`, from its bits: `2^e` or `2^(e+1)` as its
 /// mantissa is below or above √2 (no `log2`, `round` or `powi`).
 pub fn nearest_power_of_two(x: f64) -> f64 {
-    let bits = x.to_bits();
-    let e = ((bits >> 52) & 0x7ff) as i64 - 1023;
-    let mantissa = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
-    let e = if mantissa >= std::f64::consts::SQRT_2 {
+    let e = binary_exponent(x);
+    let mantissa = x / power_of_two(e);
+    power_of_two(if mantissa >= std::f64::consts::SQRT_2 {
         e + 1
     } else {
         e
-    };
-    f64::from_bits(((e + 1023) as u64) << 52)
+    })
 }
 
 /// Most sweeps of [`balance`] (it stops at the first sweep that changes nothing; the vessel's
@@ -362,7 +373,7 @@ pub fn balance<const N: usize>(a: &mut SMatrix<f64, N, N>, scale: &mut SVector<f
     // An augmented matrix (last row zero) is balanced on its dynamics alone: the forcing column
     // has no fixed size (the constant coordinate's scale is chosen per state, balance_constant)
     // and must not steer the other indices' factors.
-    let augmented = a.row(N - 1).iter().all(|v| *v == 0.0);
+    let augmented = is_augmented(a);
     let s = a.as_mut_slice();
     let mut m = [[0.0; N]; N];
     for (j, col) in m.iter_mut().enumerate() {
@@ -391,8 +402,7 @@ pub fn balance<const N: usize>(a: &mut SMatrix<f64, N, N>, scale: &mut SVector<f
                 continue;
             }
             // A power of two within √2 of √q, from q's binary exponent e: 2^⌈e/2⌉.
-            let e = ((q.to_bits() >> 52) & 0x7ff) as i64 - 1023;
-            let f = f64::from_bits((((e + 1).div_euclid(2) + 1023) as u64) << 52);
+            let f = power_of_two((binary_exponent(q) + 1).div_euclid(2));
             if c[i] * f + r[i] / f < 0.95 * (c[i] + r[i]) {
                 // Column i grows by f and row i shrinks by f, and with them the other rows'
                 // and columns' sums that hold their entries.
