@@ -43,12 +43,19 @@ fn flows(c: &mut Criterion) {
         ("gauss s=3", LinearFlow::Gauss, 6),
     ] {
         let sys = VesselSystem::new(&vessel, Some(0.0)).with_linear_flow(lf);
+        // Two attitudes in turn: each call assembles flow S2 (a repeated state would be served
+        // by the kept assembly, `system/memo.rs`, and measure the solve alone).
+        let mut y1 = y0;
+        y1.q = nalgebra::Rotation3::from_euler_angles(0.02, -0.01, 0.3).into_inner();
+        let states = [y0, y1];
         for ledger in [false, true] {
+            let mut n = 0usize;
             c.bench_function(
                 &format!("flow S2: {name}{}", if ledger { " + ledger" } else { "" }),
                 |b| {
                     b.iter(|| {
-                        let mut s = y0;
+                        n += 1;
+                        let mut s = states[n & 1];
                         sys.flow_s2(&mut s, black_box(0.5), 0.0, true, ledger, order.div_ceil(2))
                     })
                 },

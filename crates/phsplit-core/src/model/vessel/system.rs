@@ -22,6 +22,7 @@ use crate::methods::Flow;
 use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
 use nalgebra::{Matrix3, SVector, Vector3};
 
+mod memo;
 mod report;
 mod s1;
 mod s2;
@@ -98,6 +99,10 @@ pub struct VesselSystem<'a> {
     /// The exact flow S2's balance beyond the structural one, per controller state and block
     /// system: computed once, at the upright attitude (`s2.rs`, `exact_balance`).
     exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
+    /// The last frozen view and flow S2 assembled (`system/memo.rs`).
+    s2_memo: memo::S2Memo<'a>,
+    /// Bit `k` set: account `k` is one of the controller's (`system/report.rs`).
+    control: u32,
 }
 
 /// Why a sub-flow gave up rather than return an unconverged result.
@@ -134,7 +139,6 @@ impl<'a> VesselSystem<'a> {
             vessel,
             control_start,
             linear: LinearFlow::Exact,
-            accounts,
             bases,
             origin,
             project: true,
@@ -151,6 +155,9 @@ impl<'a> VesselSystem<'a> {
             gave_up: Default::default(),
             actuators: vessel.actuators(),
             exact_balance: Default::default(),
+            s2_memo: Default::default(),
+            control: report::control_accounts(&accounts),
+            accounts,
         }
     }
 
@@ -242,7 +249,7 @@ impl<'a> VesselSystem<'a> {
     }
 
     /// The frozen view of a sub-step that starts at `s`.
-    fn frozen(&self, s: &VesselState, on: bool) -> Frozen<'_> {
+    fn frozen(&self, s: &VesselState, on: bool) -> Frozen<'a> {
         let mut fr = self.frozen_at(&s.q, on);
         fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
         fr.actuators = s.act;
@@ -250,7 +257,7 @@ impl<'a> VesselSystem<'a> {
     }
 
     /// The frozen view at the attitude `q`, the vessel at rest.
-    fn frozen_at(&self, q: &Matrix3<f64>, on: bool) -> Frozen<'_> {
+    fn frozen_at(&self, q: &Matrix3<f64>, on: bool) -> Frozen<'a> {
         let qt = q.transpose();
         let (euler, w) = so3::euler_and_w(q);
         Frozen {
@@ -275,16 +282,22 @@ impl<'a> VesselSystem<'a> {
 
     /// Flow S2 at the frozen view `fr` ([`Self::s2_at`]).
     fn s2_of(&self, fr: &Frozen, ledger: bool) -> S2Builder {
-        let mut b = S2Builder::new(ledger.then_some(self.accounts.len()));
+        let mut b = S2Builder::new(None);
+        self.s2_into(fr, ledger, &mut b);
+        b
+    }
+
+    /// [`Self::s2_of`] into the builder `b`, which keeps its allocation.
+    fn s2_into(&self, fr: &Frozen, ledger: bool, b: &mut S2Builder) {
+        b.reset(ledger.then_some(self.accounts.len()));
         // The kinematics of the position, x' = Q v: the body's, not a force's.
         b.rate_v(Sys::Trans, Sys::Trans, &fr.q);
         for (f, base) in self.vessel.forces.iter().zip(&self.bases) {
             b.base = *base;
-            f.add_s2(fr, &mut b);
+            f.add_s2(fr, b);
         }
         let body = &self.vessel.body;
         b.finish(&body.minv_blocks, body.is_diagonal());
-        b
     }
 
     /// The natural periods (s) of the oscillating modes of flow S2 linearised at the attitude

@@ -210,6 +210,32 @@ impl S2Builder {
             base: 0,
         }
     }
+    /// Empty the builder for a new assembly booking to `accounts` accounts, as [`Self::new`]
+    /// does, keeping the ledger's allocation.
+    pub(crate) fn reset(&mut self, accounts: Option<usize>) {
+        for b in &mut self.sys {
+            for m in [&mut b.auu, &mut b.auv, &mut b.auw, &mut b.avu, &mut b.awv] {
+                m.fill(0.0);
+            }
+            b.cu.fill(0.0);
+            b.cw.fill(0.0);
+        }
+        for m in self.nu_u.iter_mut().chain(self.nu_v.iter_mut()).flatten() {
+            m.fill(0.0);
+        }
+        for m in &mut self.other_v {
+            m.fill(0.0);
+        }
+        self.cross = None;
+        self.base = 0;
+        match (accounts, &mut self.booked) {
+            (Some(n), Some(v)) => {
+                v.clear();
+                v.resize(n, [Rows::ZERO; 2]);
+            }
+            (n, v) => *v = n.map(|n| vec![[Rows::ZERO; 2]; n]),
+        }
+    }
     /// Add a force on the momentum of `sys`, booked to the component's account `account`
     /// (its index in [`Force::accounts`]), or to none (`None`: a conservative exchange between
     /// stores of H, like the restoring forces).

@@ -1,14 +1,24 @@
 //! What the vessel reports at a state, for the results and the probe: the components'
 //! outputs, the force and moment of each ledger account, and the controller's wrench.
 
-use super::super::forces::{Forcing, Output, S2Builder};
+use super::super::forces::{Forcing, Frozen, Output, Rows};
 use super::super::state::VesselState;
 use super::VesselSystem;
+use crate::solve::Account;
 use nalgebra::Vector3;
 
 /// The accounts whose forces make up the controller's force in the probe
 /// ([`crate::solve::Model::probe`]): its P, I and D parts, or what its thrusters deliver.
 pub(super) const CONTROL_ACCOUNTS: [&str; 3] = ["control", "control_damping", "thrusters"];
+
+/// The controller's accounts among `accounts`, as bits (bit `k`: account `k`).
+pub(super) fn control_accounts(accounts: &[Account]) -> u32 {
+    accounts
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| CONTROL_ACCOUNTS.contains(&a.name))
+        .fold(0, |bits, (k, _)| bits | 1 << k)
+}
 
 impl VesselSystem<'_> {
     /// The quantities the components report at `s` and time `t` ([`super::forces::Force::outputs`]).
@@ -47,34 +57,37 @@ impl VesselSystem<'_> {
     }
 
     /// The controller's force and moment (body frame, about the body origin) at `s` on a step
-    /// that starts at `t`: the sum of [`Self::account_wrenches`] over [`CONTROL_ACCOUNTS`],
-    /// assembled from the components that book to them only (the probe runs after every step).
+    /// that starts at `t`: the sum of [`Self::account_wrenches`] over [`CONTROL_ACCOUNTS`]. The
+    /// probe runs after every step, at the state the next step starts from: the whole of flow
+    /// S2 is assembled (with each account's rows) and kept, and the next step's first sub-step,
+    /// when it is S2, uses it (`system/memo.rs`).
     pub(super) fn control_wrench(&self, s: &VesselState, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let fr = self.frozen(s, self.control_on(t));
+        let on = self.control_on(t);
         let z = self.blocks_of(s);
-        let mut b = S2Builder::new(Some(self.accounts.len()));
-        let mut g = Forcing::new();
-        for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
-            if f.accounts()
-                .iter()
-                .any(|a| CONTROL_ACCOUNTS.contains(&a.name))
-            {
-                b.base = base;
-                f.add_s2(&fr, &mut b);
+        let wrench = |fr: &Frozen, booked: &[[Rows; 2]]| {
+            let mut g = Forcing::new();
+            let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+            for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
+                let mine = self.control >> base & ((1 << f.accounts().len()) - 1);
+                if mine == 0 {
+                    continue;
+                }
                 if f.forced() {
                     g.base = base;
-                    f.add_forcing(&fr, t, &z, &mut g);
+                    f.add_forcing(fr, t, &z, &mut g);
+                }
+                for i in 0..f.accounts().len() {
+                    if mine >> i & 1 == 1 {
+                        let k = base + i;
+                        force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked[k][0];
+                        moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked[k][1];
+                    }
                 }
             }
-        }
-        let booked = b.booked.expect("built with the ledger");
-        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
-        for (k, a) in self.accounts.iter().enumerate() {
-            if CONTROL_ACCOUNTS.contains(&a.name) {
-                force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked[k][0];
-                moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked[k][1];
-            }
-        }
-        (force, moment)
+            (force, moment)
+        };
+        self.with_s2(s, on, true, |fr, b| {
+            wrench(fr, b.booked.as_deref().expect("assembled with the ledger"))
+        })
     }
 }

@@ -40,19 +40,19 @@ impl VesselSystem<'_> {
         ledger: bool,
         stages: usize,
     ) -> Work {
-        let fr = self.frozen(s, on);
-        let b = self.s2_of(&fr, ledger);
         let z0 = self.blocks_of(s);
-        // A forcing part is collocated with the coupled system's solver whether or not the
-        // systems are coupled (their blocks of six are then block-diagonal).
-        let (z1, work) = if b.cross.is_some() || self.forced {
-            self.coupled_s2(&fr, &b, &z0, h, t, stages)
-        } else {
-            match self.linear {
-                LinearFlow::Gauss => self.gauss_s2(&b, &z0, h, stages),
-                LinearFlow::Exact => self.exact_s2(&b, &z0, h, fr.control_on),
+        let (z1, work) = self.with_s2(s, on, ledger, |fr, b| {
+            // A forcing part is collocated with the coupled system's solver whether or not the
+            // systems are coupled (their blocks of six are then block-diagonal).
+            if b.cross.is_some() || self.forced {
+                self.coupled_s2(fr, b, &z0, h, t, stages)
+            } else {
+                match self.linear {
+                    LinearFlow::Gauss => self.gauss_s2(b, &z0, h, stages),
+                    LinearFlow::Exact => self.exact_s2(b, &z0, h, fr.control_on),
+                }
             }
-        };
+        });
         self.set_blocks(s, &z1);
         work
     }
@@ -69,6 +69,21 @@ impl VesselSystem<'_> {
         s: usize,
     ) -> ([Z3; 2], Work) {
         let nan = [[Vector3::from_element(f64::NAN); 3]; 2];
+        if s == 1 {
+            // The implicit midpoint rule (SP2's S2), without the stage arrays of more stages.
+            let (Some((zt1, st)), Some((zr1, sr))) = (
+                gauss::midpoint_step(&b.sys[0], &z0[0], h),
+                gauss::midpoint_step(&b.sys[1], &z0[1], h),
+            ) else {
+                return (nan, Work::default());
+            };
+            let work = match &b.booked {
+                // Gauss's weight for one stage is 1.
+                Some(booked) => self.power_at(booked, &[st, sr]).scaled(h),
+                None => Work::default(),
+            };
+            return ([zt1, zr1], work);
+        }
         let (Some((zt1, st)), Some((zr1, sr))) = (
             gauss::blocks_step(&b.sys[0], &z0[0], h, s),
             gauss::blocks_step(&b.sys[1], &z0[1], h, s),
