@@ -430,3 +430,33 @@ CATALOGUE += [
                                         {"vessel.added_mass[1][5]": 1.0, "vessel.added_mass[5][1]": 2.0}), E,
         ("vessel.added_mass[1][5]", "vessel.added_mass[5][1]", "different values")),
 ]
+
+
+def _small_store() -> str:
+    """A sweep store of one computed case (a fresh temporary folder)."""
+    from phsplit.batch import Settings, Sweep, run_sweep
+
+    d = os.path.join(tempfile.mkdtemp(), "store")
+    sw = Sweep(Settings(t_span=(0.0, 1.0), h=0.5, method="sp2"), phsplit.Vessel.paper(), [{"vessel.mass": 6e6}])
+    run_sweep(sw, d, n_workers=1, progress=False)
+    return d
+
+
+def _batch_file() -> str:
+    """A batch file of two cases, as a large sweep writes them."""
+    from phsplit.batch import Settings, _run_cases
+
+    d = tempfile.mkdtemp()
+    os.makedirs(os.path.join(d, "cases"))
+    _run_cases(phsplit.Vessel.paper().to_dict(), Settings(t_span=(0.0, 1.0), h=0.5, method="sp2"),
+               [{"vessel.mass": 6e6}, {"vessel.mass": 7e6}], d, ["case_00000_a", "case_00001_b"])
+    return os.path.join(d, "cases", os.listdir(os.path.join(d, "cases"))[0])
+
+
+CATALOGUE += [
+    Bad("a case id the sweep store does not hold",
+        lambda: phsplit.results.sweep_case(_small_store(), "case_00007_0000000000000000"), E,
+        ("holds no case", "case_00007_0000000000000000")),
+    Bad("rerun of a sweep's batch file", lambda: phsplit.rerun(_batch_file()), E,
+        ("cases of a sweep", "sweep_case")),
+]

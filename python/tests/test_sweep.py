@@ -239,3 +239,72 @@ def test_a_task_lost_outside_its_case_is_reported_not_stored(tmp_path, monkeypat
         res = run_sweep(sw, str(store), scheduler=cluster.scheduler_address, progress=False)
     assert res["computed"] == 1 and res["lost"] == 0 and res["reused"] == 2
     assert done_cases(str(store)) == {sw.case_id(i) for i in range(3)}
+
+
+def test_a_large_sweep_stores_its_cases_in_batches_and_reads_them_back_as_cases(tmp_path):
+    """From 16 cases a worker, a task runs up to 32 cases and writes them as one file stacked
+    along ``case`` (a netCDF4 file costs about as much per variable as it holds). The store still
+    holds every case once: resume, the summary read back from the files, open_sweep in the sweep's
+    order, each case equal to its own simulation, and a lost batch file computed again."""
+    from phsplit.batch import _batch_size, store_index, write_summary
+
+    assert [_batch_size(n, 2) for n in (9, 15, 16, 40, 1000)] == [1, 1, 1, 2, 32]
+    settings = Settings(t_span=(0.0, 10.0), h=0.5, method="sp2", control_start=0.0, save_every=4)
+    gains = np.linspace(2e5, 8e5, 37)
+    cases = [{"control.kp_translational[0]": float(k)} for k in gains[:20]]
+    cases.append({"vessel.mass": -1.0})  # refused: stored with its error, no run
+    cases += [{"control.kp_translational[0]": float(k)} for k in gains[20:]]
+    sw = Sweep(settings, phsplit.Vessel.paper(), cases, name="batches")
+    store = tmp_path / "store"
+    res = run_sweep(sw, str(store), n_workers=1, progress=False)
+    ids = [sw.case_id(i) for i in range(len(cases))]
+    assert res["computed"] == 38 and done_cases(str(store)) == set(ids)
+    files = sorted(os.listdir(store / "cases"))
+    assert len(files) == 10 and all(f.startswith("batch_") for f in files)  # 38 cases, 4 a file (the last 2)
+    index = store_index(str(store))
+    sizes = []
+    for f in files:
+        with phsplit.open_dataset(store / "cases" / f) as b:
+            sizes.append(b.sizes["case"])
+    assert sorted(i for _, i in index.values()) == sorted(j for n in sizes for j in range(n))
+    with phsplit.open_dataset(store / "summary.nc") as s:
+        assert list(s["status"].values).count("invalid") == 1 and list(s["status"].values)[20] == "invalid"
+    written = (store / "summary.csv").read_text()
+    write_summary(str(store), ids)
+    assert (store / "summary.csv").read_text() == written
+    with phsplit.open_sweep(store) as all_cases:
+        assert list(all_cases["case_id"].values) == ids[:20] + ids[21:]
+        for i in (0, 19, 36):
+            case = cases[i if i < 20 else i + 1]
+            direct = phsplit.simulate(phsplit.with_parameters(phsplit.Vessel.paper(), case), settings=settings)
+            np.testing.assert_array_equal(all_cases["position"].values[i], direct.x)
+            np.testing.assert_array_equal(all_cases["energy"].values[i], direct.energy)
+        np.testing.assert_array_equal(all_cases["control_kp_translational_0"].values, gains)
+    # A batch file holds the run's record: what the cases share as attributes, what differs (the
+    # vessel with the case's parameters) along case.
+    with phsplit.open_dataset(store / "cases" / files[0]) as b:
+        assert b.attrs["method"] == "sp2" and "phsplit_batch" in b.attrs
+        k = int(np.flatnonzero(b["case_status"].values == "completed")[0])
+        assert str(b["case_id"].values[k]) in ids
+        v = phsplit.Vessel.from_toml_str(str(b["run_phsplit_vessel"].values[k]))
+        assert v.to_dict()["control"]["kp_translational"][0] == json_case(b, k)["control.kp_translational[0]"]
+    # one case of a batch as the result of its own run: reruns to the bit
+    one = phsplit.results.sweep_case(store, ids[25])
+    assert float(one["time"][-1]) == 10.0 and one.attrs["case_status"] == "completed"
+    assert phsplit.results.compare(one, phsplit.rerun(one)) == []
+    with pytest.raises(phsplit.InvalidInputError, match="sweep_case"):
+        phsplit.rerun(store / "cases" / files[0])
+    # a second run reuses everything; a lost batch is computed again, and only its cases
+    assert run_sweep(sw, str(store), n_workers=1, progress=False)["computed"] == 0
+    lost = store / "cases" / files[3]
+    with phsplit.open_dataset(lost) as b:
+        n_lost = b.sizes["case"]
+    os.unlink(lost)
+    res = run_sweep(sw, str(store), n_workers=1, progress=False)
+    assert res["computed"] == n_lost and res["reused"] == len(cases) - n_lost and done_cases(str(store)) == set(ids)
+
+
+def json_case(b, k):
+    import json
+
+    return json.loads(str(b["case_parameters"].values[k]))

@@ -8,9 +8,12 @@
   the run, or an existing cluster given by address.
   - Each finished case is written to ``STORE/cases/<id>.nc`` (temporary file, then rename), so
     a case is stored once, whole, or not at all: by the workers of a LocalCluster, by the client
-    for a cluster given by address.
+    for a cluster given by address. A large sweep (16 cases or more a worker) runs its cases in
+    tasks of up to 32 and writes each task's cases as one file, ``STORE/cases/batch_<digest>.nc``,
+    stacked along ``case`` (a netCDF4 file costs about 0.5 ms a variable to write, twice the
+    integration of a case in one file of its own); :func:`phsplit.open_sweep` reads both.
   - A rerun on the same store computes only the missing cases.
-  - A worker that dies loses only its running tasks, which Dask reschedules.
+  - A worker that dies loses only its running tasks (a case, or a batch), which Dask reschedules.
   - A case that fails (bad parameters, divergence) is stored with its error and does not stop
     the others.
   - A case whose task fails for a reason outside the case (a worker killed again and again:
@@ -411,9 +414,151 @@ def _write_case(store: str, cid: str, result: dict) -> dict:
                         a["case_status"], a["case_error"])
 
 
-def done_cases(store: str) -> set[str]:
+#: Most cases in one task and one file of a sweep store (a *batch*; :func:`_batch_size`).
+MAX_BATCH = 32
+
+
+def _batch_size(n: int, workers: int) -> int:
+    """Cases per task for ``n`` cases on ``workers`` workers: one (a file per case) below 16
+    cases a worker; beyond, about 8 tasks a worker, at most :data:`MAX_BATCH` cases each. A
+    netCDF4 file costs about 0.5 ms per variable to write whatever its length (HDF5's object
+    headers; 17 ms for a case's 29 variables against 9 ms to integrate it), so a large sweep
+    writes its cases stacked along ``case``, 32 to a file, and loses at most one batch a worker
+    if a worker dies."""
+    return max(1, min(MAX_BATCH, n // (8 * max(1, workers))))
+
+
+def _run_cases(base_tables: dict, settings: Settings, cases: list[dict], store: str | None = None,
+               cids: list[str] | None = None) -> list[dict]:
+    """Run one task's cases (on a Dask worker): one case as :func:`_run_case`; several, each by
+    :func:`_run_case`, and with ``store`` (a LocalCluster's worker) written as one batch file, of
+    which only the summary rows come back."""
+    cids = cids or [None] * len(cases)
+    if len(cases) == 1:
+        return [_run_case(base_tables, settings, cases[0], store, cids[0])]
+    results = [_run_case(base_tables, settings, c, None, cid) for c, cid in zip(cases, cids)]
+    if store is not None:
+        return [{"row": r} for r in _write_batch(store, cids, results)]
+    return results
+
+
+#: The per-case attributes of a case file that a batch file holds as variables along ``case``.
+_CASE_ATTRS = ("case_status", "case_error", "case_parameters", "case_summary")
+
+
+def _batch_dataset(cids: list[str], results: list[dict]):
+    """The cases of one task stacked along ``case``: every variable of the case files with a
+    leading ``case`` dimension (NaN beyond a case's last saved time and for a case that did not
+    run), ``case_id`` as a coordinate, the case files' own attributes (status, error, parameters,
+    summary) as variables along ``case``, and each run attribute that differs between the cases
+    (the vessel file with its parameters, the number of steps, ...) as a variable
+    ``run_<attribute>`` (empty for a case that did not run); the attributes the cases that ran
+    share stay global."""
+    import xarray as xr
+
+    n = len(results)
+    ran = [r.get("dataset") for r in results]
+    done = [d for d in ran if d is not None]
+    ref = max(done, key=lambda d: d.sizes.get("time", 0)) if done else None
+    variables: dict[str, Any] = {}
+    coords: dict[str, Any] = {"case_id": ("case", np.array(cids, dtype=object), {"long_name": "case identifier"})}
+    attrs: dict[str, Any] = {}
+    if ref is not None:
+        for name, c in ref.coords.items():
+            coords[name] = c.variable
+        names = list(dict.fromkeys(k for d in done for k in d.data_vars))
+        for name in names:
+            proto = next(d[name] for d in done if name in d.data_vars)
+            shape = tuple(ref.sizes[k] if k == "time" else proto.sizes[k] for k in proto.dims)
+            out = np.full((n,) + shape, np.nan)
+            for i, d in enumerate(ran):
+                if d is not None and name in d.data_vars:
+                    a = np.asarray(d[name].values, dtype=float)
+                    out[(i,) + tuple(slice(0, k) for k in a.shape)] = a
+            variables[name] = (("case",) + proto.dims, out, dict(proto.attrs))
+        keys = list(dict.fromkeys(k for d in done for k in d.attrs))
+        for k in keys:
+            vals = [d.attrs.get(k) if d is not None else None for d in ran]
+            if all(k in d.attrs and str(d.attrs[k]) == str(ref.attrs.get(k)) for d in done):
+                attrs[k] = ref.attrs[k]  # the same for every case that ran
+            else:
+                variables[f"run_{k}"] = ("case", np.array(["" if v is None else str(v) for v in vals], dtype=object),
+                                         {"long_name": f"the run attribute {k} of each case"})
+    for k, key in zip(_CASE_ATTRS, ("status", "error", "case", "summary")):
+        if key in ("case", "summary"):
+            vals = [json.dumps(r.get(key, {}), sort_keys=True) for r in results]
+        else:
+            vals = [str(r.get(key, "")) for r in results]
+        variables[k] = ("case", np.array(vals, dtype=object), {"long_name": k.replace("_", " ")})
+    from .results import cf_finish
+
+    ds = xr.Dataset(variables, coords=coords, attrs=attrs)
+    ds = cf_finish(ds, attrs.get("title", "phsplit sweep cases"), "sweep")
+    ds.attrs["phsplit_batch"] = f"{n} cases of a sweep along 'case' (phsplit.open_sweep reads the store)"
+    return ds
+
+
+def _write_batch(store: str, cids: list[str], results: list[dict]) -> list[dict]:
+    """Write one task's cases as one file, atomically: ``STORE/cases/batch_<digest>.nc`` (the
+    digest over the case ids), via a temporary file and a rename. Returns their summary rows."""
+    import dask
+
+    from .plotting import publish
+
+    ds = _batch_dataset(cids, results)
+    name = "batch_" + hashlib.sha256("\n".join(cids).encode()).hexdigest()[:16] + ".nc"
+    cases_dir = os.path.join(store, "cases")
+    fd, tmp = tempfile.mkstemp(dir=cases_dir, prefix=".tmp-", suffix=".nc")
+    os.close(fd)
+    try:
+        # Each variable in one HDF5 chunk (as a case file), on the worker's own lock.
+        with dask.config.set(scheduler="synchronous"):
+            ds.to_netcdf(tmp, encoding={k: {"chunksizes": ds[k].shape} for k in ds.data_vars
+                                        if ds[k].dtype.kind == "f" and ds[k].size})
+        publish(tmp, os.path.join(cases_dir, name))
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    # The rows as write_summary reads them back from the file (the JSON's sorted keys).
+    meta = {k: [str(x) for x in ds[k].values] for k in _CASE_ATTRS}
+    return [_summary_row(cid, json.loads(meta["case_parameters"][i]), json.loads(meta["case_summary"][i]),
+                         meta["case_status"][i], meta["case_error"][i]) for i, cid in enumerate(cids)]
+
+
+def store_index(store: str) -> dict[str, tuple[str, int | None]]:
+    """Where each stored case of a sweep store is: ``{case id: (file, index along case)}``, the
+    index ``None`` for a file of one case (``cases/<id>.nc``), else its place in a batch file
+    (``cases/batch_<digest>.nc``). A case stored twice (two sweeps writing one store at once) is
+    taken from the first file in name order."""
+    import xarray as xr
+
     d = os.path.join(store, "cases")
-    return {f[:-3] for f in os.listdir(d) if f.endswith(".nc") and not f.startswith(".")} if os.path.isdir(d) else set()
+    out: dict[str, tuple[str, int | None]] = {}
+    if not os.path.isdir(d):
+        return out
+    for f in sorted(os.listdir(d)):
+        if f.startswith(".") or not f.endswith(".nc"):
+            continue
+        p = os.path.join(d, f)
+        if f.startswith("batch_"):
+            try:
+                # Through xarray, as every other read of the store: its cache of open files
+                # and netCDF4 handles of its own on one file do not mix (a crash in HDF5).
+                with xr.open_dataset(p, decode_times=False) as nc:
+                    ids = [str(x) for x in nc["case_id"].values]
+            except (OSError, ValueError, KeyError) as e:
+                raise _core.InvalidInputError(f"{p!r} is not a batch file of a sweep store that phsplit can read: "
+                                              f"{e}; remove it and run the sweep again to compute its cases") from None
+            for i, cid in enumerate(ids):
+                out.setdefault(cid, (p, i))
+        else:
+            out.setdefault(f[:-3], (p, None))
+    return out
+
+
+def done_cases(store: str) -> set[str]:
+    """The ids of the cases a sweep store holds (in files of one case or in batch files)."""
+    return set(store_index(store))
 
 
 def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers: int | None = None,
@@ -430,6 +575,7 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
     ids = [sweep.case_id(i) for i in range(len(sweep.cases))]
     have = done_cases(store)  # cases of other settings stay in the store under their own ids, unused
     todo = [i for i, cid in enumerate(ids) if cid not in have]
+    workers = n_workers or os.cpu_count() or 2
     from .plotting import publish
 
     fd, tmp = tempfile.mkstemp(dir=store, prefix=".tmp-", suffix=".json")
@@ -445,7 +591,7 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
         if scheduler:
             client = Client(scheduler, set_as_default=False)
         else:
-            cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 2, threads_per_worker=1,
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
                                    processes=True, host="127.0.0.1", dashboard_address=None)
             client = Client(cluster, set_as_default=False)
         try:
@@ -454,23 +600,36 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
             # (atomically, as the client would), so writing runs on every worker instead of
             # queueing on the client. Elsewhere the store is local to the client, which writes.
             at = os.path.abspath(store) if scheduler is None else None
-            futures = {client.submit(_run_case, base_tables, sweep.settings, sweep.cases[i], at, ids[i], key=ids[i],
-                                     retries=retries, pure=False): ids[i] for i in todo}
+            if scheduler is not None:
+                workers = max(1, len(client.scheduler_info().get("workers", {})))
+            k = _batch_size(len(todo), workers)
+            tasks = [todo[j:j + k] for j in range(0, len(todo), k)]
+            futures = {client.submit(_run_cases, base_tables, sweep.settings, [sweep.cases[i] for i in task], at,
+                                     [ids[i] for i in task], key=ids[task[0]], retries=retries, pure=False): task
+                       for task in tasks}
             with tqdm(total=len(ids), initial=len(ids) - len(todo), unit="case", disable=not progress) as bar:
                 for fut in as_completed(futures, loop=client.loop):
-                    cid = futures[fut]
+                    task = futures[fut]
+                    cids = [ids[i] for i in task]
                     try:
-                        result = fut.result()
+                        results = fut.result()
                     except Exception as e:  # noqa: BLE001 - a task's failure is reported, not fatal
-                        # Not the case's own outcome (that comes back as a result): listed in the
-                        # summary, not stored, so that the next run computes it.
-                        lost.append(cid)
-                        rows[cid] = _summary_row(cid, sweep.cases[ids.index(cid)], {}, "error",
-                                                 f"{type(e).__name__}: {e} (not stored: run the sweep again)")
-                        bar.update(1)
+                        # Not the cases' own outcome (that comes back as a result): listed in the
+                        # summary, not stored, so that the next run computes them.
+                        for i, cid in zip(task, cids):
+                            lost.append(cid)
+                            rows[cid] = _summary_row(cid, sweep.cases[i], {}, "error",
+                                                     f"{type(e).__name__}: {e} (not stored: run the sweep again)")
+                        bar.update(len(task))
                         continue
-                    rows[cid] = result["row"] if "row" in result else _write_case(store, cid, result)
-                    bar.update(1)
+                    if all("row" in r for r in results):
+                        for cid, r in zip(cids, results):
+                            rows[cid] = r["row"]
+                    elif len(results) == 1:
+                        rows[cids[0]] = _write_case(store, cids[0], results[0])
+                    else:
+                        rows.update(zip(cids, _write_batch(store, cids, results)))
+                    bar.update(len(task))
         finally:
             client.close()
             if cluster is not None:
@@ -494,14 +653,23 @@ def write_summary(store: str, ids: list[str], known: dict[str, dict] | None = No
     import xarray as xr
 
     rows = []
+    index = store_index(store) if not known or any(cid not in known for cid in ids) else {}
+    batches: dict[str, dict[str, list[str]]] = {}  # a batch file's metadata, read once
     for cid in ids:
         if known and cid in known:
             rows.append(known[cid])
             continue
-        with xr.open_dataset(os.path.join(store, "cases", f"{cid}.nc")) as ds:
-            a = ds.attrs
-            rows.append(_summary_row(cid, json.loads(a["case_parameters"]), json.loads(a["case_summary"]),
-                                     a["case_status"], a["case_error"]))
+        path, i = index[cid]
+        if i is None:
+            with xr.open_dataset(path) as ds:
+                a = {k: ds.attrs[k] for k in _CASE_ATTRS}
+        else:
+            if path not in batches:
+                with xr.open_dataset(path) as ds:
+                    batches[path] = {k: [str(x) for x in ds[k].values] for k in _CASE_ATTRS}
+            a = {k: v[i] for k, v in batches[path].items()}
+        rows.append(_summary_row(cid, json.loads(a["case_parameters"]), json.loads(a["case_summary"]),
+                                 a["case_status"], a["case_error"]))
     cols = list(dict.fromkeys(k for r in rows for k in r))
     path = os.path.join(store, "summary.csv")
     with open(path, "w", newline="") as f:

@@ -30,7 +30,7 @@ import numpy as np
 from . import _core
 from .simulate import Settings, Solution, Vessel, simulate
 
-__all__ = ["open_dataset", "open_sweep", "rerun", "compare", "run_chunks", "settings_of", "vessel_of", "cf_finish"]
+__all__ = ["open_dataset", "open_sweep", "sweep_case", "rerun", "compare", "run_chunks", "settings_of", "vessel_of", "cf_finish"]
 
 
 def open_dataset(path: str | os.PathLike[str], **kw: Any):
@@ -109,11 +109,44 @@ def _joined(sols: list[Solution]):
                      combine_attrs="override")
 
 
+def sweep_case(store: str | os.PathLike[str], case_id: str):
+    """One case of a sweep store as the dataset of its own run (loaded into memory), whether it
+    is stored in a file of its own or in a batch file: the batch's variables at the case, and its
+    per-case variables (``case_status``, ..., ``run_<attribute>``) back as attributes, so that
+    :func:`rerun` and :func:`compare` take it like any result file."""
+    from .batch import _CASE_ATTRS, store_index
+
+    index = store_index(os.fspath(store))
+    if case_id not in index:
+        raise _core.InvalidInputError(f"the sweep store {os.fspath(store)!r} holds no case {case_id!r}")
+    path, i = index[case_id]
+    with open_dataset(path) as ds:
+        if i is None:
+            return ds.load()
+        one = ds.isel(case=i).load()
+    per_case = [k for k in one.data_vars if k.startswith("run_") or k in _CASE_ATTRS]
+    attrs = {k[4:] if k.startswith("run_") else k: str(one[k].values) for k in per_case}
+    one = one.drop_vars(per_case + ["case_id"])
+    one.attrs.pop("phsplit_batch", None)
+    for k, v in attrs.items():
+        one.attrs[k] = int(v) if k == "steps" else v
+    # A case that stopped early has NaN rows beyond its last saved time in the batch.
+    if "time" in one.dims and "energy" in one:
+        ok = np.flatnonzero(np.isfinite(one["energy"].values))
+        one = one.isel(time=slice(0, int(ok[-1]) + 1 if len(ok) else 0))
+    return one
+
+
 def rerun(source, progress: bool = False):
     """Rerun the simulation a phsplit file (a path or an open dataset) records, with the same
     calls, and return its result as a dataset laid out like the file. A run the file records as
-    interrupted is rerun to the step it reached."""
+    interrupted is rerun to the step it reached. A case of a sweep's batch file: take it with
+    :func:`sweep_case` first."""
     ds = open_dataset(source) if isinstance(source, (str, os.PathLike)) else source
+    if "case" in ds.dims:
+        raise _core.InvalidInputError(
+            f"the result holds {ds.sizes['case']} cases of a sweep (a batch file of a sweep store); rerun one "
+            "case: phsplit.results.rerun(phsplit.results.sweep_case(STORE, CASE_ID))")
     vessel, settings = vessel_of(ds), settings_of(ds)
     if "initial_state" not in ds:
         raise _core.InvalidInputError("the file has no initial_state variable to start the rerun from")
@@ -210,13 +243,16 @@ def cf_finish(ds, title: str, what: str):
 
 def open_sweep(store: str | os.PathLike[str]):
     """The cases of a sweep store (``phsplit sweep``) as one dataset with a ``case`` dimension,
-    opened lazily through Dask (``xarray.open_mfdataset``), in the order of the sweep file.
-    Cases that did not run (invalid parameters) are left out; ``summary.nc`` lists every case
-    with its status. The varied parameters are coordinates along ``case``, and ``case_id``
-    names each."""
+    opened lazily through Dask, in the order of the sweep file, from files of one case
+    (``cases/<id>.nc``) and batch files (``cases/batch_<digest>.nc``, a large sweep's cases
+    stacked along ``case``) alike. Cases that did not run (invalid parameters) are left out;
+    ``summary.nc`` lists every case with its status. The varied parameters are coordinates along
+    ``case``, and ``case_id`` names each."""
     import json
 
     import xarray as xr
+
+    from .batch import store_index
 
     root = os.fspath(store)
     meta = os.path.join(root, "sweep.json")
@@ -224,21 +260,39 @@ def open_sweep(store: str | os.PathLike[str]):
         raise _core.InvalidInputError(f"{root!r} is not a sweep store (no sweep.json in it)")
     with open(meta) as f:
         cases = json.load(f)["cases"]
-    paths, ids, params = [], [], []
-    for cid, case in cases.items():
-        p = os.path.join(root, "cases", f"{cid}.nc")
-        if not os.path.isfile(p):
-            continue  # not computed yet
-        with xr.open_dataset(p, decode_times=False) as d:
+    index = store_index(root)
+    opened: dict[str, Any] = {}
+    parts, ids, params = [], [], []
+    try:
+        for cid, case in cases.items():
+            if cid not in index:
+                continue  # not computed yet
+            path, i = index[cid]
+            if path not in opened:
+                opened[path] = xr.open_dataset(path, decode_times=False, chunks={})
+            d = opened[path]
             if "time" not in d.dims:
                 continue  # an invalid case: nothing ran
-        paths.append(p)
-        ids.append(cid)
-        params.append(case)
-    if not paths:
-        raise _core.InvalidInputError(f"the sweep store {root!r} holds no computed case yet")
-    ds = xr.open_mfdataset(paths, combine="nested", concat_dim="case", decode_times=False,
-                           data_vars="all", coords="minimal", compat="override", combine_attrs="drop_conflicts")
+            if i is None:
+                one = d.expand_dims("case")
+            else:
+                if str(d["case_status"].values[i]) == "invalid":
+                    continue
+                one = d.isel(case=[i]).drop_vars(["case_id", "case_status", "case_error", "case_parameters",
+                                                   "case_summary"]
+                                                  + [k for k in d.data_vars if k.startswith("run_")])
+            parts.append(one)
+            ids.append(cid)
+            params.append(case)
+        if not parts:
+            raise _core.InvalidInputError(f"the sweep store {root!r} holds no computed case yet")
+        ds = xr.concat(parts, dim="case", data_vars="all", coords="minimal", compat="override", join="outer",
+                       combine_attrs="drop_conflicts")
+    except BaseException:
+        for d in opened.values():
+            d.close()
+        raise
+    ds.set_close(lambda: [d.close() for d in opened.values()])
     ds = ds.assign_coords(case_id=("case", np.array(ids)))
     for k in sorted({k for c in params for k in c}):
         name = k.replace(".", "_").replace("[", "_").replace("]", "")
