@@ -186,6 +186,8 @@ pub struct S2Builder {
     pub booked: Option<Vec<[Rows; 2]>>,
     /// First account of the component being assembled.
     pub(crate) base: usize,
+    /// The ledger rows' allocation while the builder has no ledger ([`Self::reset`]).
+    spare: Option<Vec<[Rows; 2]>>,
 }
 
 impl S2Builder {
@@ -208,6 +210,7 @@ impl S2Builder {
             cross: None,
             booked: accounts.map(|n| vec![[Rows::ZERO; 2]; n]),
             base: 0,
+            spare: None,
         }
     }
     /// Empty the builder for a new assembly booking to `accounts` accounts, as [`Self::new`]
@@ -228,12 +231,15 @@ impl S2Builder {
         }
         self.cross = None;
         self.base = 0;
-        match (accounts, &mut self.booked) {
-            (Some(n), Some(v)) => {
+        // The rows' allocation is kept aside while the builder has no ledger.
+        let mut v = self.booked.take().or(self.spare.take()).unwrap_or_default();
+        match accounts {
+            Some(n) => {
                 v.clear();
                 v.resize(n, [Rows::ZERO; 2]);
+                self.booked = Some(v);
             }
-            (n, v) => *v = n.map(|n| vec![[Rows::ZERO; 2]; n]),
+            None => self.spare = Some(v),
         }
     }
     /// Add a force on the momentum of `sys`, booked to the component's account `account`

@@ -4,14 +4,22 @@
 //! booked rows) depends on the state only through the attitude `Q` and whether the controller
 //! acts, and, for a component with a forcing part, the velocities `ν₀` it linearises at and the
 //! actuators' memory ([`Frozen::velocity`], [`Frozen::actuators`]: only such components read
-//! them). Only flow S1 changes `Q`. So in a composition that begins and ends with S2 (SP2 is
-//! `S2(h/2) S1(h) S2(h/2)`), the S2 that ends a step and the S2 that begins the next are
-//! assembled at the same attitude, and so is the probe after the step. The assembly is kept
-//! with the bits of what it was built from and reused when they match bit for bit (`Q`, the
-//! controller, the ledger; and the momenta and the actuators' memory when a component has a
-//! forcing part), with the view's velocities and memory set to the new state's: a run's
-//! numbers are the same as without it.
-
+//! them). The assembly is kept with the bits of what it was built from and reused when they
+//! match bit for bit (`Q`, the controller; and the momenta and the actuators' memory when a
+//! component has a forcing part), with the view's velocities and memory set to the new state's;
+//! one made with the ledger's rows serves a sub-step without the ledger too. A run's numbers are
+//! the same as without it.
+//!
+//! Where it is reused:
+//! - The probe after a step (the running maxima of a sweep's summary) and the next step's first
+//!   sub-step, when that is S2 (S2 outermost, the default): both at the step's end state. The
+//!   probe then assembles S2 whole instead of the controller's rows alone; where no sub-step
+//!   takes that assembly (S1 outermost), the probe goes back to the controller's rows after the
+//!   first step ([`S2Memo`] keeps which).
+//! - Consecutive S2 sub-steps with nothing between them that turns `Q`: the S2 that ends a step
+//!   and the S2 that begins the next, but only without the projection onto the restoring
+//!   invariant (docs/model.md §3.6), which turns `Q` after every step; and a vessel settled at
+//!   rest, whose `Q` no longer changes. Sub-steps separated by S1 never share one.
 use super::super::forces::{Frozen, S2Builder};
 use super::super::state::{Actuators, VesselState};
 use super::VesselSystem;
@@ -65,12 +73,29 @@ struct Entry<'a> {
     key: Key,
     fr: Frozen<'a>,
     b: S2Builder,
+    /// Made by the probe, and since then reused by a sub-step.
+    by_probe: bool,
+    reused: bool,
+}
+
+struct Kept<'a> {
+    entry: Option<Entry<'a>>,
+    /// Whether the probe's whole assembly is taken by the next sub-step (until one was not).
+    probe_pays: bool,
 }
 
 /// The kept assembly of one vessel system. A system shared by threads that step at once keeps
 /// it for one of them; the others assemble as if there were none.
-#[derive(Default)]
-pub(super) struct S2Memo<'a>(Mutex<Option<Entry<'a>>>);
+pub(super) struct S2Memo<'a>(Mutex<Kept<'a>>);
+
+impl Default for S2Memo<'_> {
+    fn default() -> Self {
+        Self(Mutex::new(Kept {
+            entry: None,
+            probe_pays: true,
+        }))
+    }
+}
 
 impl Clone for S2Memo<'_> {
     /// A copy of the system starts with nothing kept.
@@ -88,12 +113,13 @@ impl std::fmt::Debug for S2Memo<'_> {
 impl<'a> VesselSystem<'a> {
     /// Call `f` with the frozen view of a sub-step that starts at `s` and flow S2 assembled
     /// there (with `ledger`, each account's rows too), reusing the last assembly when it was
-    /// made from the same bits.
+    /// made from the same bits; `by_probe`: the call is the probe's.
     pub(super) fn with_s2<R>(
         &self,
         s: &VesselState,
         on: bool,
         ledger: bool,
+        by_probe: bool,
         f: impl FnOnce(&Frozen<'a>, &S2Builder) -> R,
     ) -> R {
         let Ok(mut guard) = self.s2_memo.0.try_lock() else {
@@ -101,29 +127,47 @@ impl<'a> VesselSystem<'a> {
             let fr = self.frozen(s, on);
             return f(&fr, &self.s2_of(&fr, ledger));
         };
-        let entry = match &mut *guard {
+        let kept = &mut *guard;
+        let entry = match &mut kept.entry {
             Some(e) if e.key.matches(s, on, self.forced) && (e.b.booked.is_some() || !ledger) => {
+                if e.by_probe && !by_probe {
+                    e.reused = true;
+                    kept.probe_pays = true;
+                }
                 e.fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
                 e.fr.actuators = s.act;
                 e
             }
             Some(e) => {
+                if e.by_probe && !e.reused {
+                    kept.probe_pays = false;
+                }
                 e.key = Key::of(s, on);
                 e.fr = self.frozen(s, on);
+                e.by_probe = by_probe;
+                e.reused = false;
                 self.s2_into(&e.fr, ledger, &mut e.b);
                 e
             }
             None => {
                 let fr = self.frozen(s, on);
                 let b = self.s2_of(&fr, ledger);
-                guard.insert(Entry {
+                kept.entry.insert(Entry {
                     key: Key::of(s, on),
                     fr,
                     b,
+                    by_probe,
+                    reused: false,
                 })
             }
         };
         serve(entry, ledger, f)
+    }
+
+    /// Whether the probe should assemble S2 whole (its assembly is taken by the next sub-step)
+    /// rather than the controller's rows alone.
+    pub(super) fn probe_assembles_whole(&self) -> bool {
+        self.s2_memo.0.try_lock().is_ok_and(|k| k.probe_pays)
     }
 }
 
@@ -175,7 +219,7 @@ mod tests {
                 for on in [true, false] {
                     let fresh = sys.s2_of(&sys.frozen(&s, on), ledger);
                     for _ in 0..2 {
-                        sys.with_s2(&s, on, ledger, |fr, b| {
+                        sys.with_s2(&s, on, ledger, false, |fr, b| {
                             assert_eq!(b.sys, fresh.sys);
                             assert_eq!(b.cross, fresh.cross);
                             assert_eq!(b.booked, fresh.booked);
@@ -184,16 +228,16 @@ mod tests {
                     }
                 }
             }
-            let before = sys.with_s2(&s, true, true, |_, b| b.sys);
+            let before = sys.with_s2(&s, true, true, false, |_, b| b.sys);
             // A new linear momentum, then a new angular one.
             for change in [
                 |s: &mut VesselState| s.p *= 3.0,
                 |s: &mut VesselState| s.m *= 2.0,
             ] {
-                let last = sys.with_s2(&s, true, true, |_, b| b.sys);
+                let last = sys.with_s2(&s, true, true, false, |_, b| b.sys);
                 change(&mut s);
                 let fresh = sys.s2_of(&sys.frozen(&s, true), true);
-                sys.with_s2(&s, true, true, |fr, b| {
+                sys.with_s2(&s, true, true, false, |fr, b| {
                     assert_eq!(fr.velocity, sys.frozen(&s, true).velocity);
                     assert_eq!(b.sys, fresh.sys);
                     assert_eq!(b.booked, fresh.booked);
@@ -203,11 +247,45 @@ mod tests {
             }
             s.q = Rotation3::from_euler_angles(0.1, -0.05, 0.3).into_inner();
             let fresh = sys.s2_of(&sys.frozen(&s, true), true);
-            sys.with_s2(&s, true, true, |_, b| {
+            sys.with_s2(&s, true, true, false, |_, b| {
                 assert_eq!(b.sys, fresh.sys);
                 assert_ne!(b.sys, before);
             });
         }
+    }
+
+    /// The probe assembles S2 whole where the next sub-step takes it (S2 outermost) and goes
+    /// back to the controller's rows where none does (S1 outermost); the probe's maxima are the
+    /// same either way, to the bit.
+    #[test]
+    fn the_probe_assembles_whole_only_where_the_next_sub_step_takes_it() {
+        use crate::methods::{Method, Outer};
+        use crate::solve::{run, Options};
+        let v = Vessel::paper();
+        let method: Method = "sp2".parse().unwrap();
+        let mut maxima = vec![];
+        for (outer, whole) in [(Outer::Dissipative, true), (Outer::Conservative, false)] {
+            let sys = VesselSystem::new(&v, Some(0.0)).with_extrema(true);
+            let opts = Options {
+                t0: 0.0,
+                h: 0.5,
+                n_steps: 40,
+                last_h: 0.5,
+                save_every: 10,
+                outer,
+                ledger: true,
+            };
+            let tr = run(&sys, &method, v.initial_state(), &opts).unwrap();
+            assert_eq!(sys.probe_assembles_whole(), whole, "{outer:?}");
+            // The same maxima as the probe's own assembly of the controller's rows gives.
+            let fresh = VesselSystem::new(&v, Some(0.0)).with_extrema(true);
+            fresh.s2_memo.0.lock().unwrap().probe_pays = false;
+            let again = run(&fresh, &method, v.initial_state(), &opts).unwrap();
+            assert_eq!(tr.probe_max, again.probe_max);
+            assert_eq!(tr.t, again.t);
+            maxima.push(tr.probe_max);
+        }
+        assert!(maxima[0][0] > 0.0);
     }
 
     /// What lets the kept assembly leave the momenta and the actuators' memory out of its key

@@ -1,7 +1,7 @@
 //! What the vessel reports at a state, for the results and the probe: the components'
 //! outputs, the force and moment of each ledger account, and the controller's wrench.
 
-use super::super::forces::{Forcing, Frozen, Output, Rows};
+use super::super::forces::{Forcing, Frozen, Output, Rows, S2Builder};
 use super::super::state::VesselState;
 use super::VesselSystem;
 use crate::solve::Account;
@@ -60,7 +60,8 @@ impl VesselSystem<'_> {
     /// that starts at `t`: the sum of [`Self::account_wrenches`] over [`CONTROL_ACCOUNTS`]. The
     /// probe runs after every step, at the state the next step starts from: the whole of flow
     /// S2 is assembled (with each account's rows) and kept, and the next step's first sub-step,
-    /// when it is S2, uses it (`system/memo.rs`).
+    /// when it is S2, uses it (`system/memo.rs`); where it is not S2, the probe assembles the
+    /// components that book to the controller's accounts alone.
     pub(super) fn control_wrench(&self, s: &VesselState, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let on = self.control_on(t);
         let z = self.blocks_of(s);
@@ -86,8 +87,19 @@ impl VesselSystem<'_> {
             }
             (force, moment)
         };
-        self.with_s2(s, on, true, |fr, b| {
-            wrench(fr, b.booked.as_deref().expect("assembled with the ledger"))
-        })
+        if self.probe_assembles_whole() {
+            return self.with_s2(s, on, true, true, |fr, b| {
+                wrench(fr, b.booked.as_deref().expect("assembled with the ledger"))
+            });
+        }
+        let fr = self.frozen(s, on);
+        let mut b = S2Builder::new(Some(self.accounts.len()));
+        for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
+            if self.control >> base & ((1 << f.accounts().len()) - 1) != 0 {
+                b.base = base;
+                f.add_s2(&fr, &mut b);
+            }
+        }
+        wrench(&fr, &b.booked.expect("built with the ledger"))
     }
 }

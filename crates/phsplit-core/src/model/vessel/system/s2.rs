@@ -41,7 +41,7 @@ impl VesselSystem<'_> {
         stages: usize,
     ) -> Work {
         let z0 = self.blocks_of(s);
-        let (z1, work) = self.with_s2(s, on, ledger, |fr, b| {
+        let (z1, work) = self.with_s2(s, on, ledger, false, |fr, b| {
             // A forcing part is collocated with the coupled system's solver whether or not the
             // systems are coupled (their blocks of six are then block-diagonal).
             if b.cross.is_some() || self.forced {
@@ -77,11 +77,12 @@ impl VesselSystem<'_> {
             ) else {
                 return (nan, Work::default());
             };
-            let work = match &b.booked {
-                // Gauss's weight for one stage is 1.
-                Some(booked) => self.power_at(booked, &[st, sr]).scaled(h),
-                None => Work::default(),
-            };
+            let mut work = Work::default();
+            if let Some(booked) = &b.booked {
+                // Gauss's weight for one stage is 1 (added to zero, as the general path does:
+                // no account's work comes back as -0).
+                work += self.power_at(booked, &[st, sr]).scaled(h);
+            }
             return ([zt1, zr1], work);
         }
         let (Some((zt1, st)), Some((zr1, sr))) = (
