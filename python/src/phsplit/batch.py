@@ -468,12 +468,13 @@ def _batch_dataset(cids: list[str], results: list[dict]):
             coords[name] = c.variable
         names = list(dict.fromkeys(k for d in done for k in d.data_vars))
         for name in names:
-            proto = next(d[name] for d in done if name in d.data_vars)
+            # Variables, not DataArrays: building a DataArray per case and name cost 30 ms a batch.
+            proto = next(d.variables[name] for d in done if name in d.data_vars)
             shape = tuple(ref.sizes[k] if k == "time" else proto.sizes[k] for k in proto.dims)
             out = np.full((n,) + shape, np.nan)
             for i, d in enumerate(ran):
                 if d is not None and name in d.data_vars:
-                    a = np.asarray(d[name].values, dtype=float)
+                    a = np.asarray(d.variables[name].values, dtype=float)
                     out[(i,) + tuple(slice(0, k) for k in a.shape)] = a
             variables[name] = (("case",) + proto.dims, out, dict(proto.attrs))
         keys = list(dict.fromkeys(k for d in done for k in d.attrs))
