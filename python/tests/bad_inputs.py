@@ -460,3 +460,18 @@ CATALOGUE += [
     Bad("rerun of a sweep's batch file", lambda: phsplit.rerun(_batch_file()), E,
         ("cases of a sweep", "sweep_case")),
 ]
+
+
+def _cli_on_batch(*args: str) -> Callable[[], object]:
+    """``phsplit <args> batch.nc`` on a batch file of a sweep store."""
+    def run():
+        with open(_batch_file(), "rb") as f:
+            data = f.read()
+        return cli(*args, "batch.nc", files={"batch.nc": data})()
+    return run
+
+
+CATALOGUE += [
+    Bad("CLI: rerun of a sweep's batch file", _cli_on_batch("rerun"), C, ("cases of a sweep", "sweep_case")),
+    Bad("CLI: plot of a sweep's batch file", _cli_on_batch("plot"), C, ("cases of a sweep", "sweep_case")),
+]

@@ -308,3 +308,52 @@ def json_case(b, k):
     import json
 
     return json.loads(str(b["case_parameters"].values[k]))
+
+
+def test_batches_keep_each_case_whole_where_cases_differ(tmp_path):
+    """From a review of the batch files: a case that diverges inside a batch comes back with its
+    own saved times and reruns to the bit; a refused case says it did not run; cases whose
+    variables differ in shape (rate-limited thrusters keep a memory in the state) are written a
+    file each; long runs saved densely are not batched; open_sweep's dataset closes its files, so
+    the store opens again."""
+    import tomllib
+
+    from phsplit.batch import _batch_size, _run_cases, _saved_rows, store_index
+
+    assert _batch_size(1000, 2, _saved_rows(Settings(t_span=(0.0, 3600.0), h=0.05, save_every=1))) == 1
+    assert _batch_size(1000, 2, _saved_rows(Settings(t_span=(0.0, 3600.0), h=0.5, save_every=20))) == 32
+    store = tmp_path / "mixed"
+    (store / "cases").mkdir(parents=True)
+    settings = Settings(t_span=(0.0, 200.0), h=1.0, method="rk4", save_every=3)
+    cases = [{"vessel.mass": m} for m in (6e6, 1e5, 7e6, -1.0)]  # 1e5 kg diverges; -1 is refused
+    cids = [f"case_{i:05d}_x" for i in range(4)]
+    rows = _run_cases(phsplit.Vessel.paper().to_dict(), settings, cases, str(store), cids)
+    assert [r["row"]["status"] for r in rows] == ["completed", "failed", "completed", "invalid"]
+    assert rows[1]["row"]["diverged"]
+    assert len(os.listdir(store / "cases")) == 1
+    short = phsplit.results.sweep_case(store, cids[1])
+    assert len(short["time"]) < len(phsplit.results.sweep_case(store, cids[0])["time"])
+    assert phsplit.results.compare(short, phsplit.rerun(short)) == []
+    with pytest.raises(phsplit.InvalidInputError, match="did not run"):
+        phsplit.results.sweep_case(store, cids[3])
+    # rate-limited thrusters on one case only: the states differ in length, each case its own file
+    scenario = tomllib.loads(open(os.path.join(os.path.dirname(phsplit.__file__), "scenarios",
+                                               "pipelay.toml")).read())
+    base = phsplit.Vessel.paper().to_dict()
+    for k in ("setpoint", "pipe", "thrusters"):
+        base[k] = scenario[k]
+    other = tmp_path / "thrusters"
+    (other / "cases").mkdir(parents=True)
+    cids = ["case_00000_a", "case_00001_b", "case_00002_c"]
+    _run_cases(base, Settings(t_span=(0.0, 2.0), h=0.5, method="sp2", control_start=0.0),
+               [{"vessel.mass": 6.4e6}, {"thrusters.unit[0].thrust_rate": 1e5}, {"vessel.mass": 6.5e6}],
+               str(other), cids)
+    assert sorted(os.listdir(other / "cases")) == sorted(f"{c}.nc" for c in cids)
+    assert set(store_index(str(other))) == set(cids)
+    # open_sweep's dataset closes what it opened: the store opens again
+    sw = Sweep(Settings(t_span=(0.0, 4.0), h=0.5, method="sp2"), phsplit.Vessel.paper(),
+               [{"vessel.mass": float(m)} for m in np.linspace(6e6, 7e6, 20)], name="reopen")
+    run_sweep(sw, str(tmp_path / "reopen"), n_workers=1, progress=False)
+    for _ in range(2):
+        with phsplit.open_sweep(tmp_path / "reopen") as ds:
+            assert ds.sizes["case"] == 20 and float(ds["energy"].isel(case=3, time=-1)) > 0

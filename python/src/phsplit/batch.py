@@ -418,14 +418,27 @@ def _write_case(store: str, cid: str, result: dict) -> dict:
 MAX_BATCH = 32
 
 
-def _batch_size(n: int, workers: int) -> int:
-    """Cases per task for ``n`` cases on ``workers`` workers: one (a file per case) below 16
-    cases a worker; beyond, about 8 tasks a worker, at most :data:`MAX_BATCH` cases each. A
-    netCDF4 file costs about 0.5 ms per variable to write whatever its length (HDF5's object
-    headers; 17 ms for a case's 29 variables against 9 ms to integrate it), so a large sweep
-    writes its cases stacked along ``case``, 32 to a file, and loses at most one batch a worker
-    if a worker dies."""
-    return max(1, min(MAX_BATCH, n // (8 * max(1, workers))))
+#: Most bytes of saved results in one batch (about 640 bytes a saved row of a case).
+MAX_BATCH_BYTES = 64 * 2**20
+
+
+def _batch_size(n: int, workers: int, rows: int = 1) -> int:
+    """Cases per task for ``n`` cases on ``workers`` workers, each saving ``rows`` rows: one (a
+    file per case) below 16 cases a worker; beyond, about 8 tasks a worker, at most
+    :data:`MAX_BATCH` cases and :data:`MAX_BATCH_BYTES` of results each (a batch is held in a
+    worker's memory until written; long runs saved densely stay one case a file). A netCDF4 file
+    costs about 0.5 ms per variable to write whatever its length (HDF5's object headers; 17 ms
+    for a case's 29 variables against 9 ms to integrate it), so a large sweep writes its cases
+    stacked along ``case``, and loses at most one batch a worker if a worker dies."""
+    by_size = MAX_BATCH_BYTES // (640 * max(1, rows))
+    return max(1, min(MAX_BATCH, by_size, n // (8 * max(1, workers))))
+
+
+def _saved_rows(settings: Settings) -> int:
+    """How many rows a case of ``settings`` saves (an upper bound)."""
+    t0, t1 = settings.t_span
+    steps = math.ceil((t1 - t0) / settings.h) if settings.h > 0 else 1
+    return steps // max(1, int(settings.save_every)) + 2
 
 
 def _run_cases(base_tables: dict, settings: Settings, cases: list[dict], store: str | None = None,
@@ -438,8 +451,27 @@ def _run_cases(base_tables: dict, settings: Settings, cases: list[dict], store: 
         return [_run_case(base_tables, settings, cases[0], store, cids[0])]
     results = [_run_case(base_tables, settings, c, None, cid) for c, cid in zip(cases, cids)]
     if store is not None:
+        if not _stackable(results):
+            return [{"row": _write_case(store, cid, r)} for cid, r in zip(cids, results)]
         return [{"row": r} for r in _write_batch(store, cids, results)]
     return results
+
+
+def _stackable(results: list[dict]) -> bool:
+    """Whether the cases that ran have the same variables, of the same dimensions and sizes
+    beyond time, all floating point (a parameter can add an account, or the rate-limited
+    thrusters' memory to the initial state): else each case gets a file of its own."""
+    done = [r["dataset"] for r in results if r.get("dataset") is not None]
+    if not done:
+        return True
+
+    def shape(d):
+        return {k: (v.dims, tuple(n for dim, n in zip(v.dims, v.shape) if dim != "time"), v.dtype.kind)
+                for k, v in d.variables.items() if k != "time"}
+
+    first = shape(done[0])
+    return all(kind in "f" or k in done[0].coords for k, (_, _, kind) in first.items()) and all(
+        shape(d) == first for d in done[1:])
 
 
 #: The per-case attributes of a case file that a batch file holds as variables along ``case``.
@@ -485,6 +517,9 @@ def _batch_dataset(cids: list[str], results: list[dict]):
             else:
                 variables[f"run_{k}"] = ("case", np.array(["" if v is None else str(v) for v in vals], dtype=object),
                                          {"long_name": f"the run attribute {k} of each case"})
+    rows = [d.sizes.get("time", 0) if d is not None else 0 for d in ran]
+    variables["case_time_count"] = ("case", np.array(rows, dtype=np.int32),
+                                    {"long_name": "number of saved times of each case (the rest is padding)"})
     for k, key in zip(_CASE_ATTRS, ("status", "error", "case", "summary")):
         if key in ("case", "summary"):
             vals = [json.dumps(r.get(key, {}), sort_keys=True) for r in results]
@@ -513,9 +548,12 @@ def _write_batch(store: str, cids: list[str], results: list[dict]) -> list[dict]
     os.close(fd)
     try:
         # Each variable in one HDF5 chunk (as a case file), on the worker's own lock.
+        # Text as character arrays: variable-length strings in a file that is opened twice at
+        # once (open_sweep and the store's index) broke HDF5's reads (a review reproduced it).
+        encoding = {k: {"chunksizes": ds[k].shape} for k in ds.data_vars if ds[k].dtype.kind == "f" and ds[k].size}
+        encoding.update({k: {"dtype": "S1"} for k in ds.variables if ds[k].dtype.kind in "OU"})
         with dask.config.set(scheduler="synchronous"):
-            ds.to_netcdf(tmp, encoding={k: {"chunksizes": ds[k].shape} for k in ds.data_vars
-                                        if ds[k].dtype.kind == "f" and ds[k].size})
+            ds.to_netcdf(tmp, encoding=encoding)
         publish(tmp, os.path.join(cases_dir, name))
     finally:
         if os.path.exists(tmp):
@@ -603,7 +641,7 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
             at = os.path.abspath(store) if scheduler is None else None
             if scheduler is not None:
                 workers = max(1, len(client.scheduler_info().get("workers", {})))
-            k = _batch_size(len(todo), workers)
+            k = _batch_size(len(todo), workers, _saved_rows(sweep.settings))
             tasks = [todo[j:j + k] for j in range(0, len(todo), k)]
             futures = {client.submit(_run_cases, base_tables, sweep.settings, [sweep.cases[i] for i in task], at,
                                      [ids[i] for i in task], key=ids[task[0]], retries=retries, pure=False): task
@@ -628,8 +666,10 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                             rows[cid] = r["row"]
                     elif len(results) == 1:
                         rows[cids[0]] = _write_case(store, cids[0], results[0])
-                    else:
+                    elif _stackable(results):
                         rows.update(zip(cids, _write_batch(store, cids, results)))
+                    else:
+                        rows.update((cid, _write_case(store, cid, r)) for cid, r in zip(cids, results))
                     bar.update(len(task))
         finally:
             client.close()

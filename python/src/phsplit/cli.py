@@ -471,6 +471,10 @@ def _rerun(args) -> int:
     from .results import compare, open_dataset, rerun
 
     ds = open_dataset(args.file)
+    if "case" in ds.dims:
+        ds.close()
+        raise UsageError(f"{args.file!r} holds cases of a sweep (a batch file of a sweep store), not one run; "
+                         "rerun one case in Python: phsplit.rerun(phsplit.results.sweep_case(STORE, CASE_ID))")
     if "time" not in ds.dims:
         ds.close()
         raise UsageError(f"{args.file!r} holds no run to repeat (no time dimension; a sweep summary or a case "
@@ -521,6 +525,10 @@ def _plot(args) -> int:
     with open_dataset(args.file) as ds:
         if "position" not in ds or "euler" not in ds:
             raise UsageError(f"{args.file!r} holds no trajectory (it is not a run's file)")
+        if "case" in ds.dims:
+            raise UsageError(f"{args.file!r} holds cases of a sweep (a batch file of a sweep store), not one run; "
+                             "plot one case in Python: phsplit.plotting.plot_dp(phsplit.results.sweep_case("
+                             "STORE, CASE_ID), OUT)")
         plot_dp(ds, out, watch_circle=args.watch_circle)
     print(f"wrote {os.path.abspath(out)}")
     return 0

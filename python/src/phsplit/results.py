@@ -124,16 +124,17 @@ def sweep_case(store: str | os.PathLike[str], case_id: str):
         if i is None:
             return ds.load()
         one = ds.isel(case=i).load()
+    if str(one["case_status"].values) == "invalid" or "time" not in one.dims:
+        raise _core.InvalidInputError(f"case {case_id!r} of the sweep store did not run: "
+                                      f"{one['case_error'].values}")
+    # The case's own saved times: the batch pads the shorter runs with NaN.
+    one = one.isel(time=slice(0, int(one["case_time_count"].values))).drop_vars("case_time_count")
     per_case = [k for k in one.data_vars if k.startswith("run_") or k in _CASE_ATTRS]
     attrs = {k[4:] if k.startswith("run_") else k: str(one[k].values) for k in per_case}
     one = one.drop_vars(per_case + ["case_id"])
     one.attrs.pop("phsplit_batch", None)
     for k, v in attrs.items():
-        one.attrs[k] = int(v) if k == "steps" else v
-    # A case that stopped early has NaN rows beyond its last saved time in the batch.
-    if "time" in one.dims and "energy" in one:
-        ok = np.flatnonzero(np.isfinite(one["energy"].values))
-        one = one.isel(time=slice(0, int(ok[-1]) + 1 if len(ok) else 0))
+        one.attrs[k] = int(v) if k == "steps" and v else v
     return one
 
 
@@ -279,7 +280,7 @@ def open_sweep(store: str | os.PathLike[str]):
                 if str(d["case_status"].values[i]) == "invalid":
                     continue
                 one = d.isel(case=[i]).drop_vars(["case_id", "case_status", "case_error", "case_parameters",
-                                                   "case_summary"]
+                                                   "case_summary", "case_time_count"]
                                                   + [k for k in d.data_vars if k.startswith("run_")])
             parts.append(one)
             ids.append(cid)
@@ -292,10 +293,10 @@ def open_sweep(store: str | os.PathLike[str]):
         for d in opened.values():
             d.close()
         raise
-    ds.set_close(lambda: [d.close() for d in opened.values()])
     ds = ds.assign_coords(case_id=("case", np.array(ids)))
     for k in sorted({k for c in params for k in c}):
         name = k.replace(".", "_").replace("[", "_").replace("]", "")
         ds = ds.assign_coords({name: ("case", np.array([c.get(k, np.nan) if isinstance(c.get(k), (int, float)) else np.nan
                                                          for c in params], float), {"parameter": k})})
+    ds.set_close(lambda: [d.close() for d in opened.values()])  # last: assign_coords drops it
     return ds
