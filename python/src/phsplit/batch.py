@@ -374,14 +374,32 @@ def _summary_row(cid: str, case: dict, summary: dict, status: str, error: str) -
     return {"case_id": cid, **case, **summary, "status": status, "error": error}
 
 
+def _store_file(ds, path: str, encoding: dict) -> None:
+    """Write ``ds`` to ``path`` atomically: a temporary file beside it, then a rename, so a store
+    holds a file whole or not at all."""
+    import dask
+
+    from .plotting import publish
+
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".tmp-", suffix=".nc")
+    os.close(fd)
+    try:
+        # The dataset is in memory: no dask scheduler is involved. Said explicitly, so that on a
+        # Dask worker xarray takes a local lock, not a distributed one (a round trip to the
+        # scheduler per write made writing on the workers 7 times slower).
+        with dask.config.set(scheduler="synchronous"):
+            ds.to_netcdf(tmp, encoding=encoding)
+        publish(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
 def _write_case(store: str, cid: str, result: dict) -> dict:
     """Write one case atomically: STORE/cases/<cid>.nc via a temporary file and a rename.
     Returns the case's summary row (as :func:`write_summary` would read it back)."""
     import xarray as xr
 
-    from .plotting import publish
-
-    cases_dir = os.path.join(store, "cases")
     ds = result.get("dataset")
     if ds is None:  # an invalid case: no run, only what was asked and why it was refused
         from .results import cf_finish
@@ -391,24 +409,10 @@ def _write_case(store: str, cid: str, result: dict) -> dict:
     ds.attrs.update({"case_id": cid, "case_status": result["status"], "case_error": result.get("error", ""),
                      "case_parameters": json.dumps(result["case"], sort_keys=True),
                      "case_summary": json.dumps(result.get("summary", {}), sort_keys=True)})
-    fd, tmp = tempfile.mkstemp(dir=cases_dir, prefix=".tmp-", suffix=".nc")
-    os.close(fd)
-    try:
-        # A case file is written once: each variable along the record dimension in one HDF5
-        # chunk (netCDF's default chunk of one record made writing 2.2x as slow, the file 2.1x
-        # as large).
-        # The dataset is in memory: no dask scheduler is involved. Said explicitly, so that on a
-        # Dask worker xarray takes a local lock, not a distributed one (a round trip to the
-        # scheduler per write made writing on the workers 7 times slower).
-        import dask
-
-        with dask.config.set(scheduler="synchronous"):
-            ds.to_netcdf(tmp, encoding={k: {"chunksizes": ds[k].shape} for k in ds.data_vars
-                                        if "time" in ds[k].dims and ds[k].size})
-        publish(tmp, os.path.join(cases_dir, f"{cid}.nc"))
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    # A case file is written once: each variable along the record dimension in one HDF5 chunk
+    # (netCDF's default chunk of one record made writing 2.2x as slow, the file 2.1x as large).
+    _store_file(ds, os.path.join(store, "cases", f"{cid}.nc"),
+                {k: {"chunksizes": ds[k].shape} for k in ds.data_vars if "time" in ds[k].dims and ds[k].size})
     a = ds.attrs
     return _summary_row(cid, json.loads(a["case_parameters"]), json.loads(a["case_summary"]),
                         a["case_status"], a["case_error"])
@@ -537,27 +541,14 @@ def _batch_dataset(cids: list[str], results: list[dict]):
 def _write_batch(store: str, cids: list[str], results: list[dict]) -> list[dict]:
     """Write one task's cases as one file, atomically: ``STORE/cases/batch_<digest>.nc`` (the
     digest over the case ids), via a temporary file and a rename. Returns their summary rows."""
-    import dask
-
-    from .plotting import publish
-
     ds = _batch_dataset(cids, results)
     name = "batch_" + hashlib.sha256("\n".join(cids).encode()).hexdigest()[:16] + ".nc"
-    cases_dir = os.path.join(store, "cases")
-    fd, tmp = tempfile.mkstemp(dir=cases_dir, prefix=".tmp-", suffix=".nc")
-    os.close(fd)
-    try:
-        # Each variable in one HDF5 chunk (as a case file), on the worker's own lock.
-        # Text as character arrays: variable-length strings in a file that is opened twice at
-        # once (open_sweep and the store's index) broke HDF5's reads (a review reproduced it).
-        encoding = {k: {"chunksizes": ds[k].shape} for k in ds.data_vars if ds[k].dtype.kind == "f" and ds[k].size}
-        encoding.update({k: {"dtype": "S1"} for k in ds.variables if ds[k].dtype.kind in "OU"})
-        with dask.config.set(scheduler="synchronous"):
-            ds.to_netcdf(tmp, encoding=encoding)
-        publish(tmp, os.path.join(cases_dir, name))
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    # Each variable in one HDF5 chunk (as a case file). Text as character arrays:
+    # variable-length strings in a file that is opened twice at once (open_sweep and the store's
+    # index) broke HDF5's reads (a review reproduced it).
+    encoding = {k: {"chunksizes": ds[k].shape} for k in ds.data_vars if ds[k].dtype.kind == "f" and ds[k].size}
+    encoding.update({k: {"dtype": "S1"} for k in ds.variables if ds[k].dtype.kind in "OU"})
+    _store_file(ds, os.path.join(store, "cases", name), encoding)
     # The rows as write_summary reads them back from the file (the JSON's sorted keys).
     meta = {k: [str(x) for x in ds[k].values] for k in _CASE_ATTRS}
     return [_summary_row(cid, json.loads(meta["case_parameters"][i]), json.loads(meta["case_summary"][i]),

@@ -21,6 +21,11 @@ pub(super) fn control_accounts(accounts: &[Account]) -> u32 {
 }
 
 impl VesselSystem<'_> {
+    /// Which of the `n` accounts from `base` (one component's) are the controller's, as bits.
+    fn control_bits(&self, base: usize, n: usize) -> u32 {
+        self.control >> base & ((1 << n) - 1)
+    }
+
     /// The quantities the components report at `s` and time `t` ([`super::forces::Force::outputs`]).
     pub fn outputs(&self, s: &VesselState, t: f64) -> Vec<Output> {
         let mut out = Vec::new();
@@ -69,7 +74,7 @@ impl VesselSystem<'_> {
             let mut g = Forcing::new();
             let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
             for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
-                let mine = self.control >> base & ((1 << f.accounts().len()) - 1);
+                let mine = self.control_bits(base, f.accounts().len());
                 if mine == 0 {
                     continue;
                 }
@@ -95,7 +100,7 @@ impl VesselSystem<'_> {
         let fr = self.frozen(s, on);
         let mut b = S2Builder::new(Some(self.accounts.len()));
         for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
-            if self.control >> base & ((1 << f.accounts().len()) - 1) != 0 {
+            if self.control_bits(base, f.accounts().len()) != 0 {
                 b.base = base;
                 f.add_s2(&fr, &mut b);
             }
