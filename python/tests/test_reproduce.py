@@ -106,3 +106,19 @@ def test_interrupted_run_leaves_nothing_behind(tmp_path):
     assert p.returncode == 130, err
     assert "interrupted" in err
     assert os.listdir(tmp_path) == []
+
+
+def test_a_run_interrupted_inside_the_core_stops_the_study():
+    """Ctrl-C while the core integrates returns a cut run with status "interrupted"; the study
+    must stop there (KeyboardInterrupt, which the CLI turns into exit 130 and an empty output
+    folder), not go on with the cut run (a cut reference once failed to broadcast in fig. 4)."""
+    from phsplit import reproduce as rp
+
+    def stop(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        rp.simulate(phsplit.Vessel.paper(), (0.0, 2000.0), 0.002, "sp2", control_start=0.0, progress=stop)
+    # The library's own simulate returns the cut run (documented), so the check is the study's.
+    sol = phsplit.simulate(phsplit.Vessel.paper(), (0.0, 2000.0), 0.002, "sp2", control_start=0.0, progress=stop)
+    assert sol.status == "interrupted" and sol.t[-1] < 2000.0

@@ -144,3 +144,96 @@ fn the_projection_changes_no_energy_and_keeps_the_ledger_closed() {
         );
     }
 }
+
+/// The paper vessel's `(G11, G22)` from its file, written out here (`diag(mv g GM_L, mv g GM_T)`).
+fn g_diag(v: &Vessel) -> (f64, f64) {
+    let p = &v.params["vessel"];
+    let f = |k: &str| p[k].as_float().unwrap();
+    let w = f("mass") * f("gravity");
+    (w * f("gm_longitudinal"), w * f("gm_transverse"))
+}
+
+#[test]
+fn the_projection_is_the_smallest_turn_and_leaves_round_off_alone() {
+    use nalgebra::{Rotation3, Unit};
+    let v = Vessel::paper();
+    let sys = VesselSystem::new(&v, Some(0.0));
+    let (g1, g2) = g_diag(&v);
+    let eps = f64::EPSILON;
+    let mut checked = (0, 0);
+    for (k, turn) in [3e-2, 1e-5, 1e-9, 1e-13, 3e-15, 2.0 * eps, 0.5 * eps]
+        .into_iter()
+        .enumerate()
+    {
+        // A tilted attitude, and `mu` of an attitude turned by `turn` about a horizontal-ish
+        // axis: the state is off the invariant by that much.
+        let q0 = Rotation3::from_euler_angles(0.03 + 0.01 * k as f64, -0.02, 0.7 + k as f64);
+        let axis = Unit::new_normalize(Vector3::new(0.3, -1.0, 0.2 * k as f64));
+        let target = q0 * Rotation3::from_axis_angle(&axis, turn);
+        let t_true = target.inverse() * Vector3::z();
+        let mut s = v.initial_state();
+        s.q = q0.into_inner();
+        s.mu = Vector3::new(g1 * t_true.x, g2 * t_true.y, 0.0);
+        let before = s;
+        sys.project(&mut s);
+        let q3 = before.q.transpose() * Vector3::z();
+        // The attitude's vertical the invariant asks for, from mu (independently of the code).
+        let (a, b) = (s.mu.x / g1, s.mu.y / g2);
+        let t = Vector3::new(a, b, (1.0 - a * a - b * b).sqrt());
+        let needed = t.cross(&q3).norm();
+        if needed <= 4.0 * eps {
+            assert_eq!(
+                s.q, before.q,
+                "turn {turn:e}: below the floor, Q must stay as it was"
+            );
+            checked.0 += 1;
+        } else {
+            // The smallest rotation taking t to q3 (Q ← Q E with E t = q3), by nalgebra's
+            // axis–angle with the angle by atan2 (its `rotation_between` takes the angle by
+            // acos, 1e-11 off at a turn of 1e-5).
+            let w = t.cross(&q3);
+            let e = Rotation3::from_axis_angle(&Unit::new_normalize(w), w.norm().atan2(t.dot(&q3)));
+            let want = before.q * e.into_inner();
+            assert!(
+                (s.q - want).norm() <= 32.0 * eps,
+                "turn {turn:e}: {:e}",
+                (s.q - want).norm()
+            );
+            checked.1 += 1;
+        }
+        // Either way the invariant holds to the floor (relative to G).
+        assert!(
+            invariant(&v, &s).norm() <= 8.0 * eps * invariant_scale(&v),
+            "turn {turn:e}: c = {:?}",
+            invariant(&v, &s)
+        );
+        assert!((s.q.transpose() * s.q - nalgebra::Matrix3::identity()).norm() < 1e-15);
+    }
+    assert!(checked.0 >= 1 && checked.1 >= 4, "{checked:?}");
+}
+
+#[test]
+fn after_every_step_the_invariant_holds_to_the_projection_floor() {
+    let v = Vessel::paper();
+    for (method, h) in [("sp2", 0.5), ("sp4", 1.0), ("lie", 0.25)] {
+        let sys = VesselSystem::new(&v, Some(0.0));
+        let st = Settings {
+            t_span: (0.0, 600.0),
+            h,
+            method: method.parse().unwrap(),
+            control_start: Some(0.0),
+            ledger: false,
+            ..Settings::default()
+        };
+        let traj = run(&sys, &st.method, v.initial_state(), &st.options().unwrap()).unwrap();
+        let worst = traj
+            .states
+            .iter()
+            .map(|s| invariant(&v, s).norm() / invariant_scale(&v))
+            .fold(0.0, f64::max);
+        assert!(
+            worst <= 8.0 * f64::EPSILON,
+            "{method} h={h}: |c|/G = {worst:e}"
+        );
+    }
+}

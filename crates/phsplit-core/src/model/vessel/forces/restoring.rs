@@ -26,6 +26,13 @@ use crate::model::vessel::state::VesselState;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
 
+/// The smallest turn of the attitude the projection onto the restoring invariant makes (rad,
+/// as `sin θ`): `4 ε`. The entries of `q3 = Qᵀe3` carry absolute round-off of a few `ε` from
+/// every update of `Q` (flow S1, the projection itself), so a smaller turn corrects nothing that
+/// `Q` holds. Below it the projection leaves `Q` alone: the invariant then holds to `4 ε` in
+/// `q3`, i.e. `|c| ≤ 4 ε ‖G‖` (docs/model.md §3.6).
+pub const PROJECTION_FLOOR: f64 = 4.0 * f64::EPSILON;
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Restoring {
     /// `G' = G + c r_F r_Fᵀ` (roll–pitch block; row and column 3 zero), N m.
@@ -165,11 +172,21 @@ impl Force for Restoring {
             return;
         }
         let t = Vector3::new(t0, t1, (1.0 - r2).sqrt().copysign(q3.z));
+        // `E` turns `t` into `q3`: about `t × q3 = sin θ k` by `θ`.
         let axis = t.cross(&q3);
-        let sin = axis.norm();
-        if sin == 0.0 {
+        let (sin, cos) = (axis.norm(), t.dot(&q3));
+        if sin <= PROJECTION_FLOOR && cos > 0.0 {
+            // Within the round-off of `q3` itself: the turn would only stir the last bits of
+            // `Q` (and make the next step assemble flow S2 anew for nothing).
             return;
         }
-        s.q *= so3::exp(&(axis * (sin.atan2(t.dot(&q3)) / sin)));
+        s.q *= if cos > -0.5 {
+            // Rodrigues' formula on `v = sin θ k`: `I + [v]× + [v]×² / (1 + cos θ)`, without
+            // the angle (exact for unit `t`, `q3`; well conditioned below 120°).
+            let v = so3::hat(&axis);
+            Matrix3::identity() + v + v * v / (1.0 + cos)
+        } else {
+            so3::exp(&(axis * (sin.atan2(cos) / sin)))
+        };
     }
 }

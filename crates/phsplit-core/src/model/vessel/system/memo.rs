@@ -16,10 +16,11 @@
 //!   probe then assembles S2 whole instead of the controller's rows alone; where no sub-step
 //!   takes that assembly (S1 outermost), the probe goes back to the controller's rows after the
 //!   first step ([`S2Memo`] keeps which).
-//! - Consecutive S2 sub-steps with nothing between them that turns `Q`: the S2 that ends a step
-//!   and the S2 that begins the next, but only without the projection onto the restoring
-//!   invariant (docs/model.md §3.6), which turns `Q` after every step; and a vessel settled at
-//!   rest, whose `Q` no longer changes. Sub-steps separated by S1 never share one.
+//! - Consecutive S2 sub-steps with nothing between them that turns `Q`: the S2 that ends a step,
+//!   the probe and the S2 that begins the next, wherever the projection onto the restoring
+//!   invariant (docs/model.md §3.6) leaves `Q` alone: without the projection, and with it
+//!   wherever its turn is below its floor (4ε: most steps of a long run once the transient has
+//!   passed). Sub-steps separated by S1 never share one.
 use super::super::forces::{Frozen, S2Builder};
 use super::super::state::{Actuators, VesselState};
 use super::VesselSystem;
