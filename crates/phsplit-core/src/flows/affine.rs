@@ -247,10 +247,7 @@ where
 {
     let theta = norm1 * h.abs();
     let Some(pieces) = taylor_pieces(theta) else {
-        let (abar, z, c) = unit_constant(dense(), z0);
-        let mut z1 = flow(&abar, h) * z;
-        z1[N - 1] *= c;
-        return z1;
+        return flow_action_dense(dense(), z0, h);
     };
     let tau = h / pieces as f64;
     let rho = theta / pieces as f64;
@@ -304,16 +301,7 @@ where
 {
     let theta = norm1 * h.abs();
     let Some(pieces) = taylor_pieces(theta) else {
-        let (abar, z, c) = unit_constant(dense(), z0);
-        let (f, gram) = flow_and_gramian::<N, N2>(&abar, &z, h);
-        let mut z1 = f * z;
-        z1[N - 1] *= c;
-        // Back to the caller's constant coordinate: Z = D Z' D with D = diag(1, …, 1, c).
-        let d = |i: usize| if i == N - 1 { c } else { 1.0 };
-        return (
-            z1,
-            SMatrix::from_fn(|r, j| gram[(rows[r], j)] * d(rows[r]) * d(j)),
-        );
+        return flow_action_and_gramian_rows_dense::<N, R, N2>(dense(), z0, h, rows);
     };
     let tau = h / pieces as f64;
     let rho = theta / pieces as f64;
@@ -339,6 +327,50 @@ where
         z = next;
     }
     (z, y)
+}
+
+/// [`flow_action_by`]'s fallback, the dense exponential, out of line: its matrices' frame
+/// (tens of kilobytes with Van Loan's) would otherwise be the caller's on every call, probed
+/// page by page, although the Taylor sum serves nearly every sub-step.
+#[cold]
+#[inline(never)]
+fn flow_action_dense<const N: usize>(
+    abar: SMatrix<f64, N, N>,
+    z0: &SVector<f64, N>,
+    h: f64,
+) -> SVector<f64, N>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
+    let (abar, z, c) = unit_constant(abar, z0);
+    let mut z1 = flow(&abar, h) * z;
+    z1[N - 1] *= c;
+    z1
+}
+
+/// [`flow_action_and_gramian_rows_by`]'s fallback, Van Loan's exponential, out of line (as
+/// [`flow_action_dense`]).
+#[cold]
+#[inline(never)]
+fn flow_action_and_gramian_rows_dense<const N: usize, const R: usize, const N2: usize>(
+    abar: SMatrix<f64, N, N>,
+    z0: &SVector<f64, N>,
+    h: f64,
+    rows: &[usize; R],
+) -> (SVector<f64, N>, SMatrix<f64, R, N>)
+where
+    Const<N2>: DimMin<Const<N2>, Output = Const<N2>>,
+{
+    let (abar, z, c) = unit_constant(abar, z0);
+    let (f, gram) = flow_and_gramian::<N, N2>(&abar, &z, h);
+    let mut z1 = f * z;
+    z1[N - 1] *= c;
+    // Back to the caller's constant coordinate: Z = D Z' D with D = diag(1, …, 1, c).
+    let d = |i: usize| if i == N - 1 { c } else { 1.0 };
+    (
+        z1,
+        SMatrix::from_fn(|r, j| gram[(rows[r], j)] * d(rows[r]) * d(j)),
+    )
 }
 
 /// `2^round(log2 x)` for a positive normal `x`, from its bits: `2^e` or `2^(e+1)` as its
