@@ -169,12 +169,9 @@ impl VesselSystem<'_> {
                         h,
                         &[0, 1, 2],
                     );
-                    // The momentum rows of the Gramian in the vessel's coordinates.
-                    let gram =
-                        SMatrix::<f64, 3, 10>::from_fn(|i, j| gram[(i, j)] * scale[i] * scale[j]);
+                    let w = power_weights(&gram, &scale, &minv[k]);
                     for acc in 0..self.accounts.len() {
-                        let r = power_rows(&booked[acc][k], &minv[k], k);
-                        work.0[acc] += self.sign(acc) * r.component_mul(&gram).sum();
+                        work.0[acc] += self.sign(acc) * energy(&booked[acc][k], &w, k);
                     }
                     zb1
                 }
@@ -334,19 +331,33 @@ pub(super) fn balance(b: &Blocks, minv: &Vector3<f64>) -> SVector<f64, 10> {
     })
 }
 
-/// The power of a force, `νᵀ F z̄ = Σ R ∘ (ū z̄ᵀ)`, as the rows `R = diag(M⁻¹) F` on
-/// `z̄ = (u, v, w, 1)` of system `k`, with `ν = M⁻¹u` (`M` of the paper's form: diagonal `minv`
-/// on this system). Its integral along S2 is `Σ R ∘ Y` with `Y` the momentum rows of the
-/// Gramian.
-fn power_rows(f: &Rows, minv: &Vector3<f64>, k: usize) -> SMatrix<f64, 3, 10> {
-    let mut r = SMatrix::<f64, 3, 10>::zeros();
-    r.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&(f.fnu[k] * Matrix3::from_diagonal(minv)));
-    r.fixed_view_mut::<3, 3>(0, 3).copy_from(&f.fv);
-    r.fixed_view_mut::<3, 3>(0, 6).copy_from(&f.fw);
-    r.fixed_view_mut::<3, 1>(0, 9).copy_from(&f.c);
-    for i in 0..3 {
-        r.row_mut(i).scale_mut(minv[i]);
-    }
-    r
+/// The power of a force, `νᵀ F z̄ = Σ R ∘ (ū z̄ᵀ)`, is linear in the rows
+/// `R = diag(M⁻¹) [F_k M⁻¹ | F_v | F_w | c]` on `z̄ = (u, v, w, 1)` of system `k`, with `ν = M⁻¹u`
+/// (`M` of the paper's form: diagonal `minv` on this system). Its integral along S2 is
+/// `Σ R ∘ Y` with `Y` the momentum rows of the Gramian, i.e. `Σ [F_k | F_v | F_w | c] ∘ W`
+/// with the weights `W_ij = Y_ij minv_i (minv_j for the velocity columns j < 3)`: the Gramian's
+/// rows `gram` of the balanced system, in the vessel's coordinates (`Y_ij = gram_ij s_i s_j`),
+/// weighted once for every account.
+fn power_weights(
+    gram: &SMatrix<f64, 3, 10>,
+    scale: &SVector<f64, 10>,
+    minv: &Vector3<f64>,
+) -> SMatrix<f64, 3, 10> {
+    SMatrix::<f64, 3, 10>::from_fn(|i, j| {
+        let y = gram[(i, j)] * scale[i] * scale[j] * minv[i];
+        if j < 3 {
+            y * minv[j]
+        } else {
+            y
+        }
+    })
+}
+
+/// The energy a force with rows `f` books over the sub-step, `Σ [F_k | F_v | F_w | c] ∘ W`
+/// with the weights of [`power_weights`].
+fn energy(f: &Rows, w: &SMatrix<f64, 3, 10>, k: usize) -> f64 {
+    f.fnu[k].component_mul(&w.fixed_view::<3, 3>(0, 0)).sum()
+        + f.fv.component_mul(&w.fixed_view::<3, 3>(0, 3)).sum()
+        + f.fw.component_mul(&w.fixed_view::<3, 3>(0, 6)).sum()
+        + f.c.dot(&w.column(9))
 }
