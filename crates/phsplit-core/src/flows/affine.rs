@@ -312,17 +312,19 @@ where
         let (next, m) = taylor_piece(&apply, tau, rho, &z, &mut b);
         // Y += τ Σ_k v_k b_kᵀ with v_k = Σ_j H_jk b_j[rows] (j outermost, so that the sums
         // over k are independent of each other).
-        let mut v = [[0.0; R]; MAX_DEGREE + 1];
+        // By row r, each v_r contiguous in k (the inner loop runs along a row of H).
+        let mut v = [[0.0; MAX_DEGREE + 1]; R];
         for j in 0..=m {
-            let bj: [f64; R] = std::array::from_fn(|r| b[j][rows[r]] * tau);
-            for (vk, hjk) in v[..=m].iter_mut().zip(&HILBERT[j]) {
-                for (vkr, bjr) in vk.iter_mut().zip(&bj) {
-                    *vkr += hjk * bjr;
+            for (vr, &row) in v.iter_mut().zip(rows) {
+                let bjr = b[j][row] * tau;
+                for (vrk, hjk) in vr[..=m].iter_mut().zip(&HILBERT[j]) {
+                    *vrk += hjk * bjr;
                 }
             }
         }
         for k in 0..=m {
-            y.ger(1.0, &SVector::<f64, R>::from(v[k]), &b[k], 1.0);
+            let vk = SVector::<f64, R>::from_fn(|r, _| v[r][k]);
+            y.ger(1.0, &vk, &b[k], 1.0);
         }
         z = next;
     }
