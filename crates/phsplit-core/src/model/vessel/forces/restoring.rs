@@ -175,9 +175,11 @@ impl Force for Restoring {
         // `E` turns `t` into `q3`: about `t × q3 = sin θ k` by `θ`.
         let axis = t.cross(&q3);
         let (sin, cos) = (axis.norm(), t.dot(&q3));
-        if sin <= PROJECTION_FLOOR && cos > 0.0 {
+        if sin == 0.0 || (sin <= PROJECTION_FLOOR && cos > 0.0) {
             // Within the round-off of `q3` itself: the turn would only stir the last bits of
-            // `Q` (and make the next step assemble flow S2 anew for nothing).
+            // `Q` (and make the next step assemble flow S2 anew for nothing). `sin = 0` with
+            // `cos < 0` (`t = −q3`) has no axis; it cannot occur (`t₃` takes `q3`'s sign), and
+            // is left alone, as before the floor, rather than turned by 0·π/0.
             return;
         }
         s.q *= if cos > -0.5 {
