@@ -183,10 +183,15 @@ impl Force for Restoring {
             return;
         }
         s.q *= if cos > -0.5 {
-            // Rodrigues' formula on `v = sin θ k`: `I + [v]× + [v]×² / (1 + cos θ)`, without
-            // the angle (exact for unit `t`, `q3`; well conditioned below 120°).
+            // Rodrigues' formula on the unit axis–sine `v/n` and cosine `cos/n`, with
+            // `n = |t||q3| = √(sin² + cos²)`: `E = I + [v]×/n + [v]×²/(n(n + cos θ))`, no angle
+            // and no trigonometry (well conditioned below 120°). Dividing by `n` keeps `E` a
+            // rotation although `q3` is unit only to `Q`'s round-off; without it each turn
+            // multiplied that error by `2/(1 + cos θ)`, and large turns (steps far beyond
+            // stability, a tumbling vessel) drove `Q` off the rotations (found by a review).
+            let n = (sin * sin + cos * cos).sqrt();
             let v = so3::hat(&axis);
-            Matrix3::identity() + v + v * v / (1.0 + cos)
+            Matrix3::identity() + v / n + v * v / (n * (n + cos))
         } else {
             so3::exp(&(axis * (sin.atan2(cos) / sin)))
         };
