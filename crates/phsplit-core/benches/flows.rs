@@ -105,9 +105,45 @@ fn flows(c: &mut Criterion) {
     }
 }
 
+/// One SP2 step of the paper's vessel and of the OSV preset (full added mass, cross-flow drag:
+/// the coupled flow S2 with its forcing), with the ledger and the default projection, measured
+/// as 1,000 steps of h = 0.05 s: the step costs that the ledger's number of accounts must not
+/// raise (docs/model.md §3).
+fn vessel_steps(c: &mut Criterion) {
+    let method: Method = "sp2".parse().unwrap();
+    for name in ["paper", "osv"] {
+        let vessel = Vessel::preset(name).unwrap();
+        let mut y0 = vessel.initial_state();
+        y0.p += Vector3::new(1e5, 2e4, 0.0);
+        y0.m += Vector3::new(1e5, -1e5, 3e5);
+        for lf in [LinearFlow::Exact, LinearFlow::Gauss] {
+            let sys = VesselSystem::new(&vessel, Some(0.0)).with_linear_flow(lf);
+            let opts = Options {
+                t0: 0.0,
+                h: 0.05,
+                n_steps: 1000,
+                last_h: 0.05,
+                save_every: 1000,
+                outer: Outer::Dissipative,
+                ledger: true,
+            };
+            let label = format!("{name}: 1000 steps: sp2 ({lf:?} S2) + ledger");
+            c.bench_function(&label, |b| {
+                b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
+            });
+        }
+    }
+}
+
+criterion_group! {
+    name = vessels;
+    config = Criterion::default().sample_size(30).measurement_time(std::time::Duration::from_secs(3)).warm_up_time(std::time::Duration::from_millis(500));
+    targets = vessel_steps
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(2)).warm_up_time(std::time::Duration::from_millis(500));
     targets = flows
 }
-criterion_main!(benches);
+criterion_main!(benches, vessels);

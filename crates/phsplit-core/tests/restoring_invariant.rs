@@ -118,7 +118,7 @@ fn the_projection_changes_no_energy_and_keeps_the_ledger_closed() {
         h0,
         "H depends only on p, m, mu, x: the projection must not change it"
     );
-    assert!(booked.0.iter().all(|&w| w == 0.0));
+    assert!(booked.iter().all(|w| w == 0.0));
     assert!(
         invariant(&v, &s).norm() <= 1e-15 * invariant_scale(&v),
         "{:?}",

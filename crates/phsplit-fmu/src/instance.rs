@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use phsplit_core::lie::so3;
 use phsplit_core::model::vessel::{Vessel, VesselState, VesselSystem};
 use phsplit_core::settings::Settings;
-use phsplit_core::solve::{run, Model, Options, Status};
+use phsplit_core::solve::{run, Model, Options, Role as AccountRole, Status};
 use std::sync::Arc;
 use toml::{Table, Value};
 
@@ -397,8 +397,8 @@ impl Instance {
         r.state = traj.states[last];
         // Booked per saved interval (the first is zero): here the whole communication step.
         for w in &traj.booked {
-            for (acc, x) in r.booked.iter_mut().zip(w.0.iter()) {
-                *acc += x;
+            for (k, acc) in r.booked.iter_mut().enumerate() {
+                *acc += w.get(k);
             }
         }
         r.supplied += traj.supplied.iter().sum::<f64>();
@@ -413,6 +413,20 @@ impl Instance {
         let v = self.var(vr, Type::Real)?;
         match &v.role {
             Role::Output(group, i) => self.output(group, *i),
+            Role::AccountWrench {
+                account,
+                moment,
+                axis,
+            } => {
+                let (sys, r) = self.system()?;
+                let w = sys.account_wrenches(&r.state, self.time, sys.control_on(self.time));
+                let (f, m) = w[*account];
+                Ok(if *moment { m[*axis] } else { f[*axis] })
+            }
+            Role::ComponentOutput(i) => {
+                let (sys, r) = self.system()?;
+                Ok(sys.outputs(&r.state, self.time)[*i].value)
+            }
             _ => match &self.values[vr as usize] {
                 Some(Val::Real(x)) => Ok(*x),
                 _ => Err(format!("{} has no value", v.name)),
@@ -434,6 +448,15 @@ impl Instance {
             Some(Val::String(x)) => Ok(x.clone()),
             _ => Err(format!("{} has no value", v.name)),
         }
+    }
+
+    /// The running vessel's system (its outputs are defined once the FMU is initialised).
+    fn system(&self) -> Result<(VesselSystem<'_>, &Running)> {
+        let r = self
+            .running
+            .as_ref()
+            .ok_or("outputs are defined once the FMU is initialised")?;
+        Ok((VesselSystem::new(&r.vessel, r.settings.control_start), r))
     }
 
     fn output(&self, group: &str, i: usize) -> Result<f64> {
@@ -464,8 +487,8 @@ impl Instance {
                 let on = sys.control_on(self.time);
                 let w = sys.account_wrenches(s, self.time, on);
                 let mut total = Vector3::zeros();
-                for ((name, _), (f, m)) in self.layout.accounts.iter().zip(&w) {
-                    if matches!(*name, "control" | "control_damping" | "thrusters") {
+                for (a, (f, m)) in self.layout.accounts.iter().zip(&w) {
+                    if a.role == AccountRole::Control {
                         total += if group == "control_force" { f } else { m };
                     }
                 }

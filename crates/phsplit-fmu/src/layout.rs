@@ -9,7 +9,7 @@
 
 use phsplit_core::model::vessel::{Vessel, VesselSystem};
 use phsplit_core::settings::Settings;
-use phsplit_core::solve::{AccountKind, Model};
+use phsplit_core::solve::{Account, Model};
 use toml::{Table, Value};
 
 /// An error with the message the FMU logs.
@@ -52,6 +52,17 @@ pub(crate) enum Role {
     Group(&'static str, usize),
     /// An output: its group and component (or the account index of `ledger.*`).
     Output(&'static str, usize),
+    /// The force (`moment = false`, N) or moment (N m) booked to ledger account `account`, its
+    /// body-frame component `axis`: `force_<account>.*`, `moment_<account>.*`, as the results'
+    /// variables of the same names.
+    AccountWrench {
+        account: usize,
+        moment: bool,
+        axis: usize,
+    },
+    /// The `index`-th quantity the vessel's components report
+    /// (`phsplit_core::model::vessel::forces::Force::outputs`), under its own name.
+    ComponentOutput(usize),
 }
 
 /// One scalar variable of the FMU.
@@ -85,7 +96,7 @@ pub struct Layout {
     /// tables that carry the inputs).
     pub(crate) base: Table,
     /// The ledger accounts of the vessel.
-    pub(crate) accounts: Vec<(&'static str, AccountKind)>,
+    pub(crate) accounts: Vec<Account>,
 }
 
 /// Axis names of the spatial / body components.
@@ -178,6 +189,18 @@ impl Builder {
     }
 }
 
+/// A component output's unit (CF, UDUNITS spelling, as the results write it) in the FMU's
+/// spelling (`resources` of the exporter: `m/s`, `N.m`, `deg`).
+fn fmi_unit(cf: &'static str) -> &'static str {
+    match cf {
+        "m s-1" => "m/s",
+        "rad s-1" => "rad/s",
+        "N m" => "N.m",
+        "degree" => "deg",
+        other => other,
+    }
+}
+
 /// The 3-vector `key` of the table `t` (zeros where absent).
 fn vec3_in(t: &Table, key: &str) -> [f64; 3] {
     let mut out = [0.0; 3];
@@ -267,7 +290,7 @@ impl Layout {
         let base = vessel.params.clone();
         let (settings, _) = Settings::from_table(sim).map_err(|e| e.to_string())?;
         let sys = VesselSystem::new(&vessel, Some(0.0));
-        let accounts: Vec<_> = sys.accounts().iter().map(|a| (a.name, a.kind)).collect();
+        let accounts: Vec<Account> = sys.accounts().to_vec();
         let setpoint_inputs = base.contains_key("control") && !base.contains_key("setpoint");
 
         let mut b = Builder { vars: Vec::new() };
@@ -320,13 +343,58 @@ impl Layout {
             "J",
             "stored energy H; energy supplied through the ports and dissipated since the start",
         );
-        let names: Vec<&str> = accounts.iter().map(|a| a.0).collect();
+        let names: Vec<&str> = accounts.iter().map(|a| a.name).collect();
         b.output(
             "ledger",
             &names,
             "J",
             "energy booked by the account since the start (supplied or dissipated, as its kind)",
         );
+        // Every account's force and moment, and every quantity a component reports: from the
+        // vessel's own declarations, so a new component's ports and outputs appear here with no
+        // code of the FMU's.
+        for (k, a) in accounts.iter().enumerate() {
+            for (moment, what, unit) in [(false, "force", "N"), (true, "moment", "N.m")] {
+                for (axis, n) in XYZ.iter().enumerate() {
+                    b.push(
+                        format!("{what}_{}.{n}", a.name),
+                        Type::Real,
+                        Causality::Output,
+                        None,
+                        unit,
+                        format!(
+                            "{what} booked to the ledger account {}, body frame{} ({n})",
+                            a.name,
+                            if moment {
+                                ", about the body origin"
+                            } else {
+                                ""
+                            }
+                        ),
+                        Role::AccountWrench {
+                            account: k,
+                            moment,
+                            axis,
+                        },
+                    );
+                }
+            }
+        }
+        for (i, o) in sys
+            .outputs(&vessel.initial_state(), 0.0)
+            .into_iter()
+            .enumerate()
+        {
+            b.push(
+                o.name,
+                Type::Real,
+                Causality::Output,
+                None,
+                fmi_unit(o.unit),
+                o.long_name,
+                Role::ComponentOutput(i),
+            );
+        }
         // Inputs.
         let f = vec3_of(&base, "external", "force");
         let m = vec3_of(&base, "external", "moment");
@@ -463,6 +531,13 @@ impl Layout {
                     _ => {}
                 }
             }
+        }
+        let mut seen = std::collections::HashSet::new();
+        if let Some(v) = b.vars.iter().find(|v| !seen.insert(v.name.as_str())) {
+            return Err(format!(
+                "the vessel's variable {} is declared twice (a component's output named like a ledger account's force or one of the FMU's own variables)",
+                v.name
+            ));
         }
         Ok(Self {
             kind: Kind::Vessel,

@@ -175,7 +175,7 @@ fn integrate<'py>(
     let kinds: Vec<&str> = traj.accounts.iter().map(|a| kind_name(a.kind)).collect();
     d.set_item("accounts", names)?;
     d.set_item("account_kinds", kinds)?;
-    let booked: Vec<f64> = traj.booked.iter().flat_map(|w| w.0[..k].to_vec()).collect();
+    let booked: Vec<f64> = traj.booked.iter().flat_map(|w| w.values(k)).collect();
     d.set_item("booked", PyArray1::from_vec(py, booked).reshape([n, k])?)?;
     let mut force = Vec::with_capacity(n * k * 3);
     let mut moment = Vec::with_capacity(n * k * 3);

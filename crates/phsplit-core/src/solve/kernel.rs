@@ -242,7 +242,7 @@ mod tests {
     //! the port `u`: supplied `∫ p u dt`, dissipated `∫ d p² dt`).
     use super::*;
     use crate::methods::{Method, Outer, REGISTRY};
-    use crate::solve::system::{Account, AccountKind, Model};
+    use crate::solve::system::{Account, Model};
     use crate::solve::Status;
 
     const D: f64 = 0.3;
@@ -252,16 +252,7 @@ mod tests {
         /// Blow up the S2 flow (for the failure path): `p' = +growth p`.
         growth: Option<f64>,
     }
-    const ACC: [Account; 2] = [
-        Account {
-            name: "input",
-            kind: AccountKind::Supplied,
-        },
-        Account {
-            name: "damping",
-            kind: AccountKind::Dissipated,
-        },
-    ];
+    const ACC: [Account; 2] = [Account::supplied("input"), Account::dissipated("damping")];
 
     impl Model for Osc {
         type State = [f64; 2];
@@ -313,8 +304,8 @@ mod tests {
                         let int_p2 = pe * pe * h
                             + 2.0 * pe * a * (1.0 - e) / D
                             + a * a * (1.0 - e * e) / (2.0 * D);
-                        w.0[0] = U * int_p;
-                        w.0[1] = D * int_p2;
+                        w.set(0, U * int_p);
+                        w.set(1, D * int_p2);
                     }
                     s[1] = pe + a * e;
                 }
@@ -339,8 +330,8 @@ mod tests {
         }
         fn power(&self, _t: f64, _at: f64, y: &SVector<f64, 2>) -> Work {
             let mut w = Work::default();
-            w.0[0] = y[1] * U;
-            w.0[1] = D * y[1] * y[1];
+            w.set(0, y[1] * U);
+            w.set(1, D * y[1] * y[1]);
             w
         }
     }
@@ -466,7 +457,7 @@ mod tests {
         // Positive steps (Prop. 2.2): ΔH = supplied − dissipated to round-off, by account.
         for i in 1..tr.t.len() {
             let dh = tr.energy[i] - tr.energy[i - 1];
-            assert!((dh - (tr.booked[i].0[0] - tr.booked[i].0[1])).abs() < 1e-14);
+            assert!((dh - (tr.booked[i].get(0) - tr.booked[i].get(1))).abs() < 1e-14);
             assert!(tr.dissipated[i] > 0.0);
         }
         assert_eq!(tr.last_good, *tr.states.last().unwrap());
@@ -573,7 +564,7 @@ mod tests {
             let h0 = self.energy(s);
             s[1] *= 0.5;
             let mut w = Work::default();
-            w.0[1] = h0 - self.energy(s); // removed: booked as dissipated
+            w.set(1, h0 - self.energy(s)); // removed: booked as dissipated
             w
         }
     }
@@ -637,7 +628,7 @@ mod tests {
             // The energy the projection removes is booked: the ledger closes per saved interval.
             for i in 1..b.t.len() {
                 let dh = b.energy[i] - b.energy[i - 1];
-                let bal = b.booked[i].0[0] - b.booked[i].0[1];
+                let bal = b.booked[i].get(0) - b.booked[i].get(1);
                 let tol = if name == "rk4" { 1e-6 } else { 1e-14 }; // RK: a quadrature
                 assert!((dh - bal).abs() < tol, "{name} {i}: {dh} vs {bal}");
             }

@@ -7,5 +7,7 @@ pub mod trajectory;
 
 pub use kernel::{run, run_runge_kutta, run_splitting, run_watched};
 pub use options::{Options, MAX_STEPS};
-pub use system::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
+pub use system::{
+    Account, AccountKind, FieldModel, Model, Role, SplitModel, Work, INLINE_ACCOUNTS,
+};
 pub use trajectory::{Monitor, Status, Trajectory, Unwatched};

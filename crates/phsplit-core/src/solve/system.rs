@@ -6,9 +6,6 @@
 
 use nalgebra::SVector;
 
-/// Most ledger accounts a model may declare.
-pub const MAX_ACCOUNTS: usize = 8;
-
 /// Whether an account books energy that flowed in through a port or energy dissipated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AccountKind {
@@ -18,39 +15,170 @@ pub enum AccountKind {
     Dissipated,
 }
 
+/// What an account's port is to the system, beyond its kind: the results and the probe group
+/// accounts by it (the controller's force is the sum of its accounts), so no front end keeps a
+/// list of names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Role {
+    /// A load, a port to another system, or a dissipation of the model itself.
+    #[default]
+    Plant,
+    /// A part of the controller's force (its P, I and D parts, or what its actuators deliver).
+    Control,
+}
+
 /// One account of the energy ledger: the work of one port, or the dissipation of one component.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Account {
     /// Name, unique within the model (`"control"`, `"damping"`, `"external"`, …).
     pub name: &'static str,
     pub kind: AccountKind,
+    pub role: Role,
 }
 
-/// Energy (J) or power (W) booked per account, in the order of [`Model::accounts`].
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Work(pub [f64; MAX_ACCOUNTS]);
-
-impl std::ops::AddAssign for Work {
-    fn add_assign(&mut self, o: Self) {
-        for (a, b) in self.0.iter_mut().zip(o.0) {
-            *a += b;
+impl Account {
+    /// The work of a port of the plant (a load, or a port to another system).
+    pub const fn supplied(name: &'static str) -> Self {
+        Self {
+            name,
+            kind: AccountKind::Supplied,
+            role: Role::Plant,
+        }
+    }
+    /// A dissipation of the plant.
+    pub const fn dissipated(name: &'static str) -> Self {
+        Self {
+            name,
+            kind: AccountKind::Dissipated,
+            role: Role::Plant,
+        }
+    }
+    /// The same account as a part of the controller's force.
+    pub const fn control(self) -> Self {
+        Self {
+            role: Role::Control,
+            ..self
         }
     }
 }
 
+/// Accounts whose values are kept inline, in a fixed array (the usual handful: the paper's
+/// vessel has three, the OSV in a full sea nine); the values of any further accounts are kept
+/// on the heap, so there is no ceiling on how many a model declares, and a model within the
+/// inline ones pays for none.
+pub const INLINE_ACCOUNTS: usize = 8;
+
+/// Energy (J) or power (W) booked per account, in the order of [`Model::accounts`]; an account
+/// never booked holds zero, so `Work::default()` is zero for every model.
+#[derive(Debug, Clone, Default)]
+pub struct Work {
+    inline: [f64; INLINE_ACCOUNTS],
+    /// Accounts `INLINE_ACCOUNTS..`, as far as any was booked.
+    spill: Vec<f64>,
+}
+
+impl PartialEq for Work {
+    /// Equal values per account.
+    fn eq(&self, o: &Self) -> bool {
+        let n = self.spill.len().max(o.spill.len());
+        self.inline == o.inline
+            && (0..n).all(|k| self.spill.get(k).unwrap_or(&0.0) == o.spill.get(k).unwrap_or(&0.0))
+    }
+}
+
+impl std::ops::AddAssign<&Work> for Work {
+    #[inline]
+    fn add_assign(&mut self, o: &Work) {
+        for (a, b) in self.inline.iter_mut().zip(&o.inline) {
+            *a += b;
+        }
+        if !o.spill.is_empty() {
+            self.add_spill(&o.spill);
+        }
+    }
+}
+
+impl std::ops::AddAssign for Work {
+    #[inline]
+    fn add_assign(&mut self, o: Self) {
+        *self += &o;
+    }
+}
+
 impl Work {
+    /// `f(k)` for each of `n` accounts.
+    #[inline]
+    pub fn from_fn(n: usize, mut f: impl FnMut(usize) -> f64) -> Self {
+        let mut w = Self::default();
+        for k in 0..n {
+            w.set(k, f(k));
+        }
+        w
+    }
+    /// The value of account `k`.
+    #[inline]
+    pub fn get(&self, k: usize) -> f64 {
+        match self.inline.get(k) {
+            Some(v) => *v,
+            None => self.spill.get(k - INLINE_ACCOUNTS).copied().unwrap_or(0.0),
+        }
+    }
+    /// Add `v` to account `k`.
+    #[inline]
+    pub fn add(&mut self, k: usize, v: f64) {
+        *self.slot(k) += v;
+    }
+    /// Set account `k` to `v`.
+    #[inline]
+    pub fn set(&mut self, k: usize, v: f64) {
+        *self.slot(k) = v;
+    }
+    #[inline]
+    fn slot(&mut self, k: usize) -> &mut f64 {
+        if k < INLINE_ACCOUNTS {
+            &mut self.inline[k]
+        } else {
+            self.spilled(k - INLINE_ACCOUNTS)
+        }
+    }
+    #[cold]
+    fn spilled(&mut self, j: usize) -> &mut f64 {
+        if j >= self.spill.len() {
+            self.spill.resize(j + 1, 0.0);
+        }
+        &mut self.spill[j]
+    }
+    #[cold]
+    fn add_spill(&mut self, o: &[f64]) {
+        if self.spill.len() < o.len() {
+            self.spill.resize(o.len(), 0.0);
+        }
+        for (a, b) in self.spill.iter_mut().zip(o) {
+            *a += b;
+        }
+    }
+    /// The values of the accounts kept (the inline ones and any booked beyond them).
+    pub fn iter(&self) -> impl Iterator<Item = f64> + '_ {
+        self.inline.iter().chain(&self.spill).copied()
+    }
+    /// The values of the first `n` accounts.
+    pub fn values(&self, n: usize) -> Vec<f64> {
+        (0..n).map(|k| self.get(k)).collect()
+    }
     /// `h · self`: a power held over `h`.
+    #[inline]
     pub fn scaled(mut self, h: f64) -> Self {
-        self.0.iter_mut().for_each(|v| *v *= h);
+        self.inline.iter_mut().for_each(|v| *v *= h);
+        self.spill.iter_mut().for_each(|v| *v *= h);
         self
     }
     /// The total of the accounts of `kind`.
     pub fn total(&self, accounts: &[Account], kind: AccountKind) -> f64 {
         accounts
             .iter()
-            .zip(self.0)
-            .filter(|(a, _)| a.kind == kind)
-            .map(|(_, v)| v)
+            .enumerate()
+            .filter(|(_, a)| a.kind == kind)
+            .map(|(k, _)| self.get(k))
             .sum()
     }
 }
@@ -70,7 +198,7 @@ pub trait Model {
     /// Whether the model's field is the same on steps starting at `t_a` and `t_b` (no switch
     /// between them): sub-steps of the same flow may then be merged across the boundary.
     fn same_field(&self, t_a: f64, t_b: f64) -> bool;
-    /// The ledger's accounts (at most [`MAX_ACCOUNTS`]); [`Work`] values follow this order.
+    /// The ledger's accounts, as many as the model has; [`Work`] values follow this order.
     fn accounts(&self) -> &[Account];
     /// Whether the kernels call [`Model::project`] after every step. Sub-steps are then not
     /// merged across step boundaries (the state must exist there to be projected).
@@ -90,8 +218,8 @@ pub trait Model {
     fn projects_runge_kutta(&self) -> bool {
         true
     }
-    /// Names of quantities whose running maxima over every step the kernels keep (at most
-    /// [`MAX_ACCOUNTS`]; none by default): peaks that saving every k-th state would miss.
+    /// Names of quantities whose running maxima over every step the kernels keep (none by
+    /// default): peaks that saving every k-th state would miss.
     fn probe_names(&self) -> &[&'static str] {
         &[]
     }
@@ -154,4 +282,47 @@ pub trait FieldModel<const N: usize>: Model {
     fn rhs(&self, t_step: f64, t: f64, y: &SVector<f64, N>) -> SVector<f64, N>;
     /// The power per account at `y` and time `t` on a step that starts at `t_step`.
     fn power(&self, t_step: f64, t: f64, y: &SVector<f64, N>) -> Work;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Accounts beyond the inline ones: booked, summed and compared like the first ones, and
+    /// an account never booked reads zero.
+    #[test]
+    fn work_has_no_ceiling_on_its_accounts() {
+        let n = 3 * INLINE_ACCOUNTS + 1;
+        let accounts: Vec<Account> = (0..n)
+            .map(|k| {
+                if k % 3 == 0 {
+                    Account::dissipated("d")
+                } else {
+                    Account::supplied("s")
+                }
+            })
+            .collect();
+        let mut w = Work::default();
+        for k in 0..n {
+            w.add(k, k as f64);
+        }
+        let mut v = Work::default();
+        v += &w;
+        v += w.clone().scaled(2.0);
+        for k in 0..n {
+            assert_eq!(v.get(k), 3.0 * k as f64);
+        }
+        assert_eq!(v.get(n + 5), 0.0);
+        let dissipated: f64 = (0..n).filter(|k| k % 3 == 0).map(|k| 3.0 * k as f64).sum();
+        let supplied: f64 = (0..n).filter(|k| k % 3 != 0).map(|k| 3.0 * k as f64).sum();
+        assert_eq!(v.total(&accounts, AccountKind::Dissipated), dissipated);
+        assert_eq!(v.total(&accounts, AccountKind::Supplied), supplied);
+        // Zero accounts past the stored ones do not make two values differ.
+        let mut padded = v.clone();
+        padded.set(n + 9, 0.0);
+        assert_eq!(padded, v);
+        padded.set(n + 9, 1.0);
+        assert_ne!(padded, v);
+        assert_eq!(v.values(n + 1)[n], 0.0);
+    }
 }

@@ -1,7 +1,7 @@
 //! What a run returns: saved states, the energy ledger per saved interval, and how it ended.
 
 use super::options::Options;
-use super::system::{Account, AccountKind, Model, Work, MAX_ACCOUNTS};
+use super::system::{Account, AccountKind, Model, Work};
 
 /// How a run ended.
 #[derive(Debug, Clone, PartialEq)]
@@ -81,7 +81,7 @@ impl<S> Trajectory<S> {
     /// The series of one account (J per saved interval), by name.
     pub fn account(&self, name: &str) -> Option<Vec<f64>> {
         let k = self.accounts.iter().position(|a| a.name == name)?;
-        Some(self.booked.iter().map(|w| w.0[k]).collect())
+        Some(self.booked.iter().map(|w| w.get(k)).collect())
     }
 }
 
@@ -90,6 +90,8 @@ pub(crate) struct Recorder<'m, M: Model> {
     model: &'m M,
     pub(crate) traj: Trajectory<M::State>,
     pub(crate) acc: Work,
+    /// The probe's values at the last state observed.
+    probed: Vec<f64>,
 }
 
 impl<'m, M: Model> Recorder<'m, M> {
@@ -121,6 +123,7 @@ impl<'m, M: Model> Recorder<'m, M> {
             model,
             traj,
             acc: Work::default(),
+            probed: Vec::new(),
         };
         rec.observe(t0, &y0);
         rec
@@ -131,8 +134,9 @@ impl<'m, M: Model> Recorder<'m, M> {
         if n == 0 {
             return;
         }
-        let mut v = [0.0; MAX_ACCOUNTS];
-        self.model.probe(t, y, &mut v[..n]);
+        self.probed.resize(n, 0.0);
+        self.model.probe(t, y, &mut self.probed);
+        let v = &self.probed;
         for k in 0..n {
             if v[k] > self.traj.probe_max[k] {
                 self.traj.probe_max[k] = v[k];
@@ -178,8 +182,7 @@ impl<'m, M: Model> Recorder<'m, M> {
         self.traj
             .dissipated
             .push(self.acc.total(acc, AccountKind::Dissipated));
-        self.traj.booked.push(self.acc);
-        self.acc = Work::default();
+        self.traj.booked.push(std::mem::take(&mut self.acc));
     }
 }
 

@@ -113,18 +113,6 @@ impl Vessel {
                 forces.push(f);
             }
         }
-        let accounts: Vec<&str> = forces
-            .iter()
-            .flat_map(|f| f.accounts().iter().map(|a| a.name))
-            .collect();
-        if accounts.len() > crate::solve::MAX_ACCOUNTS {
-            return Err(crate::error::Error::InvalidInput(format!(
-                "the vessel's components keep {} ledger accounts ({}); at most {} are kept: leave out a component",
-                accounts.len(),
-                accounts.join(", "),
-                crate::solve::MAX_ACCOUNTS
-            )));
-        }
         let initial = Initial::read(&mut p)?;
         let params = p.finish()?;
         Ok(Self {

@@ -19,7 +19,7 @@ use crate::flows::collocation::Z3;
 use crate::flows::rigid_body::MagnusOrder;
 use crate::lie::so3;
 use crate::methods::Flow;
-use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work, MAX_ACCOUNTS};
+use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work};
 use nalgebra::{Matrix3, SVector, Vector3};
 
 mod memo;
@@ -101,8 +101,6 @@ pub struct VesselSystem<'a> {
     exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
     /// The last frozen view and flow S2 assembled (`system/memo.rs`).
     s2_memo: memo::S2Memo<'a>,
-    /// Bit `k` set: account `k` is one of the controller's (`system/report.rs`).
-    control: u32,
 }
 
 /// Why a sub-flow gave up rather than return an unconverged result.
@@ -125,11 +123,6 @@ impl<'a> VesselSystem<'a> {
             bases.push(accounts.len());
             accounts.extend_from_slice(f.accounts());
         }
-        assert!(
-            accounts.len() <= MAX_ACCOUNTS,
-            "the components declare {} ledger accounts; at most {MAX_ACCOUNTS} are kept",
-            accounts.len()
-        );
         let origin = vessel
             .forces
             .iter()
@@ -156,7 +149,6 @@ impl<'a> VesselSystem<'a> {
             actuators: vessel.actuators(),
             exact_balance: Default::default(),
             s2_memo: Default::default(),
-            control: report::control_accounts(&accounts),
             accounts,
         }
     }
@@ -364,15 +356,13 @@ impl<'a> VesselSystem<'a> {
     /// Power per account at block states `z`, from the booked rows: `±(M⁻¹u)·f`.
     fn power_at(&self, booked: &[[Rows; 2]], z: &[Z3; 2]) -> Work {
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
-        let mut w = Work::default();
-        for k in 0..self.accounts.len() {
+        Work::from_fn(self.accounts.len(), |k| {
             let mut p = 0.0;
             for sys in 0..2 {
                 p += nu[sys].dot(&booked[k][sys].at(&nu, &z[sys]));
             }
-            w.0[k] = self.sign(k) * p;
-        }
-        w
+            self.sign(k) * p
+        })
     }
 
     /// The vector field of flow S1 (eq. 40) or S2 (eq. 41) at `s` and time `t`. Their sum is
@@ -445,23 +435,22 @@ impl<'a> VesselSystem<'a> {
         let mut w = self.power_at(b.booked.as_ref().expect("built with the ledger"), &z);
         if self.forced {
             let g = self.forcing(&fr, t, &z);
-            w += self.forcing_power(&g, &z);
+            w += self.forcing_power(&[&g], &z);
         }
         w
     }
 
-    /// The power per account of the forcing `g` at block states `z`: `±(M⁻¹u)·f`.
-    fn forcing_power(&self, g: &Forcing, z: &[Z3; 2]) -> Work {
+    /// The power per account of the sum of the forcings `gs` at block states `z`: `±(M⁻¹u)·f`.
+    fn forcing_power(&self, gs: &[&Forcing], z: &[Z3; 2]) -> Work {
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
-        let mut w = Work::default();
-        for k in 0..self.accounts.len() {
+        Work::from_fn(self.accounts.len(), |k| {
             let mut p = 0.0;
-            for sys in 0..2 {
-                p += nu[sys].dot(&g.booked[k][sys]);
+            for g in gs {
+                let f = g.booked(k);
+                p += nu[0].dot(&f[0]) + nu[1].dot(&f[1]);
             }
-            w.0[k] = self.sign(k) * p;
-        }
-        w
+            self.sign(k) * p
+        })
     }
 }
 
@@ -638,7 +627,6 @@ impl FieldModel<{ super::STATE_DIM }> for VesselSystem<'_> {
 #[cfg(test)]
 mod tests {
     use super::super::forces::external::{External, Frame};
-    use super::report::CONTROL_ACCOUNTS;
     use super::*;
     use proptest::prelude::*;
 
@@ -738,7 +726,8 @@ mod tests {
                 let (mut fw, mut mw) = (Vector3::zeros(), Vector3::zeros());
                 let mut n = 0;
                 for (a, (fa, ma)) in sys.accounts().iter().zip(&w) {
-                    if CONTROL_ACCOUNTS.contains(&a.name) {
+                    // The controller's accounts by name, as the PID and thrusters declare them.
+                    if ["control", "control_damping", "thrusters"].contains(&a.name) {
                         fw += fa;
                         mw += ma;
                         n += 1;
@@ -839,7 +828,7 @@ mod tests {
                 expect_p[2].abs(),
             ];
             for (i, e) in expect_p.iter().enumerate() {
-                prop_assert!((p.0[i] - e).abs() <= 1e-12 * gross[i].max(1.0), "account {i}: {} vs {e}", p.0[i]);
+                prop_assert!((p.get(i) - e).abs() <= 1e-12 * gross[i].max(1.0), "account {i}: {} vs {e}", p.get(i));
             }
         }
 
@@ -860,8 +849,8 @@ mod tests {
             let acc = sys.accounts();
             let sup = w.total(acc, AccountKind::Supplied);
             let dis = w.total(acc, AccountKind::Dissipated);
-            let scale = h0.abs() + w.0.iter().map(|x| x.abs()).sum::<f64>();
-            for (a, x) in acc.iter().zip(w.0) {
+            let scale = h0.abs() + w.iter().map(|x| x.abs()).sum::<f64>();
+            for (a, x) in acc.iter().zip(w.iter()) {
                 if a.kind == AccountKind::Dissipated {
                     prop_assert!(x >= 0.0, "{} dissipated {x}", a.name);
                 }
@@ -960,7 +949,7 @@ mod tests {
                         }
                     }
                     let size: f64 = expected.iter().map(|x| x.abs()).sum::<f64>() + v.energy(&s0);
-                    for (acc, (got, want)) in work.0.iter().zip(&expected).enumerate() {
+                    for (acc, (got, want)) in work.iter().zip(&expected).enumerate() {
                         assert!(
                             (got - want).abs() <= 1e-10 * size,
                             "seed {seed:?} on {on} h {h} account {}: {got} vs {want}",
@@ -1001,7 +990,7 @@ mod tests {
             );
             for k in 0..3 {
                 assert!(
-                    (wa.0[k] - wb.0[k]).abs() <= 1e-9 * wb.0[k].abs().max(1.0),
+                    (wa.get(k) - wb.get(k)).abs() <= 1e-9 * wb.get(k).abs().max(1.0),
                     "{k}: {wa:?} {wb:?}"
                 );
             }
@@ -1051,7 +1040,7 @@ mod tests {
             let vel = s.p / v.body.mass;
             let w = s.m.component_div(&v.body.inertia);
             let expect = vel.dot(&fb) + w.dot(&(mb + r.cross(&fb)));
-            assert!((sys.power(&s, 0.0, false).0[k] - expect).abs() < 1e-12 * expect.abs());
+            assert!((sys.power(&s, 0.0, false).get(k) - expect).abs() < 1e-12 * expect.abs());
             let ext = v.force("external").unwrap();
             assert!(format!("{ext:?}").contains("External"));
             let _ = External {
@@ -1118,8 +1107,8 @@ mod tests {
             let sup = work.total(acc, AccountKind::Supplied);
             let dis = work.total(acc, AccountKind::Dissipated);
             let k = acc.iter().position(|a| a.name == "damping_quadratic").unwrap();
-            prop_assert!(work.0[k] >= 0.0, "{}", work.0[k]);
-            let scale = h0.abs() + work.0.iter().map(|x| x.abs()).sum::<f64>();
+            prop_assert!(work.get(k) >= 0.0, "{}", work.get(k));
+            let scale = h0.abs() + work.iter().map(|x| x.abs()).sum::<f64>();
             prop_assert!((dh - (sup - dis)).abs() <= 1e-11 * scale, "dH {dh} vs {}", sup - dis);
         }
     }
@@ -1161,13 +1150,13 @@ mod tests {
                         );
                     }
                 }
-                let scale = wa.0.iter().map(|x| x.abs()).sum::<f64>();
+                let scale = wa.iter().map(|x| x.abs()).sum::<f64>();
                 for acc in 0..sys.accounts().len() {
                     assert!(
-                        (wa.0[acc] - wb.0[acc]).abs() <= 1e-11 * scale,
+                        (wa.get(acc) - wb.get(acc)).abs() <= 1e-11 * scale,
                         "{lf:?} {stages} account {acc}: {} vs {}",
-                        wa.0[acc],
-                        wb.0[acc]
+                        wa.get(acc),
+                        wb.get(acc)
                     );
                 }
             }
@@ -1214,13 +1203,13 @@ mod tests {
                 let acc = sys.accounts();
                 let sup = w.total(acc, AccountKind::Supplied);
                 let dis = w.total(acc, AccountKind::Dissipated);
-                for (a, x) in acc.iter().zip(w.0) {
+                for (a, x) in acc.iter().zip(w.iter()) {
                     if a.kind == AccountKind::Dissipated {
                         assert!(x >= 0.0, "{} dissipated {x}", a.name);
                     }
                 }
                 let dh = vessel.energy(&s) - h0;
-                let scale = h0.abs() + w.0.iter().map(|x| x.abs()).sum::<f64>();
+                let scale = h0.abs() + w.iter().map(|x| x.abs()).sum::<f64>();
                 assert!(
                     (dh - (sup - dis)).abs() <= 1e-11 * scale,
                     "{lf:?} h {h}: dH {dh} vs {}",

@@ -36,7 +36,7 @@ use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::vessel::params::{Params, Range};
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
 
@@ -89,14 +89,8 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
 }
 
 const ACCOUNTS: [Account; 2] = [
-    Account {
-        name: "crossflow_drag",
-        kind: AccountKind::Dissipated,
-    },
-    Account {
-        name: "crossflow_current",
-        kind: AccountKind::Supplied,
-    },
+    Account::dissipated("crossflow_drag"),
+    Account::supplied("crossflow_current"),
 ];
 
 /// On one piece `[x1, x2]` where `s = a + b x` keeps its sign: `(∫s², ∫x s², ∫s, ∫x² s, ∫x s)`,

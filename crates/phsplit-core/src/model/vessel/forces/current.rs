@@ -33,7 +33,7 @@ use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::grid::check_increasing;
 use crate::model::vessel::params::{Params, Range};
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -134,10 +134,7 @@ pub fn read(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Current
     }))
 }
 
-const ACCOUNTS: [Account; 1] = [Account {
-    name: "current",
-    kind: AccountKind::Supplied,
-}];
+const ACCOUNTS: [Account; 1] = [Account::supplied("current")];
 
 /// The current's part of the quadratic damping at the body velocity `v` and the current `vc`
 /// (body frame): `C ∘ (|v| ∘ v − |v − vc| ∘ (v − vc))`, so that with the damping's own

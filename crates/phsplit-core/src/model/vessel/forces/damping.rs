@@ -16,7 +16,7 @@
 use super::{Force, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::model::vessel::params::{Params, Range};
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::{Matrix3, SMatrix};
 use std::sync::Arc;
 
@@ -99,10 +99,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     Ok(Some(Arc::new(Damping { matrix })))
 }
 
-const ACCOUNTS: [Account; 1] = [Account {
-    name: "damping",
-    kind: AccountKind::Dissipated,
-}];
+const ACCOUNTS: [Account; 1] = [Account::dissipated("damping")];
 
 impl Force for Damping {
     fn name(&self) -> &'static str {

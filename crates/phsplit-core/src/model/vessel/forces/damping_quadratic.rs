@@ -26,7 +26,7 @@ use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::vessel::params::{Params, Range};
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
 
@@ -75,10 +75,7 @@ pub fn coefficients(p: &mut Params) -> crate::Result<Option<(Vector3<f64>, Vecto
     )))
 }
 
-const ACCOUNTS: [Account; 1] = [Account {
-    name: "damping_quadratic",
-    kind: AccountKind::Dissipated,
-}];
+const ACCOUNTS: [Account; 1] = [Account::dissipated("damping_quadratic")];
 
 impl QuadraticDamping {
     /// The coefficients of each block system: translation, rotation.

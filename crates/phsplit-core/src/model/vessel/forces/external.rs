@@ -14,7 +14,7 @@
 use super::{Force, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::model::vessel::params::{Params, Range};
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -65,10 +65,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     })))
 }
 
-const ACCOUNTS: [Account; 1] = [Account {
-    name: "external",
-    kind: AccountKind::Supplied,
-}];
+const ACCOUNTS: [Account; 1] = [Account::supplied("external")];
 
 impl External {
     /// The body-frame force and moment (about the body origin) at attitude `Qᵀ = qt`.

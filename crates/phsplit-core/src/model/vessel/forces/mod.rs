@@ -32,7 +32,7 @@ use super::state::{Actuators, VesselState};
 use super::Body;
 use crate::error::Result;
 use crate::flows::collocation::{Blocks, Z3};
-use crate::solve::{Account, MAX_ACCOUNTS};
+use crate::solve::{Account, INLINE_ACCOUNTS};
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use std::sync::Arc;
@@ -316,13 +316,16 @@ impl S2Builder {
 
 /// The forcing of flow S2 at one time and block state: what the components' non-affine or
 /// time-dependent parts add to the fields of the two block systems, and, per account, the
-/// forces they book.
-#[derive(Debug, Clone, Copy)]
+/// forces they book (the first [`INLINE_ACCOUNTS`] inline, any further on the heap, as in
+/// [`crate::solve::Work`]).
+#[derive(Debug, Clone)]
 pub struct Forcing {
     /// Added to `(u', v', w')` of each block system.
     pub g: [Z3; 2],
     /// The booked force on the momentum of each system, per account.
-    pub booked: [[Vector3<f64>; 2]; MAX_ACCOUNTS],
+    booked: [[Vector3<f64>; 2]; INLINE_ACCOUNTS],
+    /// The same for accounts `INLINE_ACCOUNTS..`, as far as any was booked.
+    spill: Vec<[Vector3<f64>; 2]>,
     /// First account of the component being evaluated.
     pub(crate) base: usize,
 }
@@ -331,21 +334,55 @@ impl Forcing {
     pub(crate) fn new() -> Self {
         Self {
             g: [[Vector3::zeros(); 3]; 2],
-            booked: [[Vector3::zeros(); 2]; MAX_ACCOUNTS],
+            booked: [[Vector3::zeros(); 2]; INLINE_ACCOUNTS],
+            spill: Vec::new(),
             base: 0,
         }
     }
     /// Add a force on the momentum of `sys`, booked to the component's account `account` (its
     /// index in [`Force::accounts`]), or to none (a conservative exchange between stores of H).
+    #[inline]
     pub fn force(&mut self, sys: Sys, account: Option<usize>, f: Vector3<f64>) {
         self.g[sys as usize][0] += f;
         if let Some(k) = account {
-            self.booked[self.base + k][sys as usize] += f;
+            let k = self.base + k;
+            match self.booked.get_mut(k) {
+                Some(b) => b[sys as usize] += f,
+                None => self.spilled(k - INLINE_ACCOUNTS)[sys as usize] += f,
+            }
         }
+    }
+    #[cold]
+    fn spilled(&mut self, j: usize) -> &mut [Vector3<f64>; 2] {
+        if j >= self.spill.len() {
+            self.spill.resize(j + 1, [Vector3::zeros(); 2]);
+        }
+        &mut self.spill[j]
+    }
+    /// No forcing again.
+    #[inline]
+    pub(crate) fn clear(&mut self) {
+        self.g = [[Vector3::zeros(); 3]; 2];
+        self.booked = [[Vector3::zeros(); 2]; INLINE_ACCOUNTS];
+        self.spill
+            .iter_mut()
+            .for_each(|b| *b = [Vector3::zeros(); 2]);
     }
     /// Add to the rate of the third state of `sys` (an integral state).
     pub fn rate_w(&mut self, sys: Sys, r: Vector3<f64>) {
         self.g[sys as usize][2] += r;
+    }
+    /// The force booked to account `k` on the momentum of each system.
+    #[inline]
+    pub fn booked(&self, k: usize) -> [Vector3<f64>; 2] {
+        match self.booked.get(k) {
+            Some(b) => *b,
+            None => self
+                .spill
+                .get(k - INLINE_ACCOUNTS)
+                .copied()
+                .unwrap_or([Vector3::zeros(); 2]),
+        }
     }
 }
 

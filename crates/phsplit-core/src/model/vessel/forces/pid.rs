@@ -37,7 +37,7 @@ use crate::flows::collocation::Z3;
 use crate::model::reference::{Interpolation, Reference, CHANNELS};
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::{Actuators, VesselState};
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
 
@@ -196,21 +196,12 @@ fn setpoint(p: &mut Params, euler_reference: &[f64; 3]) -> crate::Result<Option<
 }
 
 const ACCOUNTS: [Account; 2] = [
-    Account {
-        name: "control",
-        kind: AccountKind::Supplied,
-    },
-    Account {
-        name: "control_damping",
-        kind: AccountKind::Dissipated,
-    },
+    Account::supplied("control").control(),
+    Account::dissipated("control_damping").control(),
 ];
 
 /// With thrusters, the controller's whole force is what they deliver: one port.
-const THRUSTER_ACCOUNTS: [Account; 1] = [Account {
-    name: "thrusters",
-    kind: AccountKind::Supplied,
-}];
+const THRUSTER_ACCOUNTS: [Account; 1] = [Account::supplied("thrusters").control()];
 
 /// The controller's rows at a frozen attitude: the P and I terms (the port) and the D terms
 /// (the dissipation) of each block system, and the constant parts of the integral states'

@@ -36,7 +36,7 @@ use crate::flows::collocation::Z3;
 use crate::model::catenary::Catenary;
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::{Matrix3, Vector2, Vector3};
 use std::sync::Arc;
 
@@ -180,10 +180,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     })))
 }
 
-const ACCOUNTS: [Account; 1] = [Account {
-    name: "pipe",
-    kind: AccountKind::Supplied,
-}];
+const ACCOUNTS: [Account; 1] = [Account::supplied("pipe")];
 
 impl Pipe {
     /// The pipe with the vessel at position `x` (m) and attitude `q`, at time `t` (s). A pose

@@ -48,7 +48,7 @@ use crate::lie::so3;
 use crate::model::grid::{check_increasing, check_periodic, periodic_weights};
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::{Vector3, Vector6};
 use std::sync::Arc;
 use toml::Value;
@@ -331,16 +331,7 @@ fn components_pre<const N: usize>(c: &[Component], t: &Table<N>) -> Vec<AtFreque
     c.iter().map(|c| t.at_frequency(c.omega)).collect()
 }
 
-const ACCOUNTS: [Account; 2] = [
-    Account {
-        name: "waves",
-        kind: AccountKind::Supplied,
-    },
-    Account {
-        name: "wave_drift",
-        kind: AccountKind::Supplied,
-    },
-];
+const ACCOUNTS: [Account; 2] = [Account::supplied("waves"), Account::supplied("wave_drift")];
 
 impl Waves {
     /// The elevation (m) at the horizontal position `(x, y)` and time `t`.

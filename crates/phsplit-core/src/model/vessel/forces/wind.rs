@@ -33,7 +33,7 @@ use crate::flows::collocation::Z3;
 use crate::model::grid::{check_periodic, periodic_weights};
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
-use crate::solve::{Account, AccountKind};
+use crate::solve::Account;
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -131,10 +131,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     })))
 }
 
-const ACCOUNTS: [Account; 1] = [Account {
-    name: "wind",
-    kind: AccountKind::Supplied,
-}];
+const ACCOUNTS: [Account; 1] = [Account::supplied("wind")];
 
 impl Wind {
     /// The wind speed at time `t` (m/s).

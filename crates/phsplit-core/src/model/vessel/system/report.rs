@@ -1,31 +1,19 @@
 //! What the vessel reports at a state, for the results and the probe: the components'
 //! outputs, the force and moment of each ledger account, and the controller's wrench.
 
-use super::super::forces::{Forcing, Frozen, Output, Rows, S2Builder};
+use super::super::forces::{Force, Forcing, Frozen, Output, Rows, S2Builder};
 use super::super::state::VesselState;
 use super::VesselSystem;
-use crate::solve::Account;
+use crate::solve::Role;
 use nalgebra::Vector3;
 
-/// The accounts whose forces make up the controller's force in the probe
-/// ([`crate::solve::Model::probe`]): its P, I and D parts, or what its thrusters deliver.
-pub(super) const CONTROL_ACCOUNTS: [&str; 3] = ["control", "control_damping", "thrusters"];
-
-/// The controller's accounts among `accounts`, as bits (bit `k`: account `k`).
-pub(super) fn control_accounts(accounts: &[Account]) -> u32 {
-    accounts
-        .iter()
-        .enumerate()
-        .filter(|(_, a)| CONTROL_ACCOUNTS.contains(&a.name))
-        .fold(0, |bits, (k, _)| bits | 1 << k)
+/// Whether a component books to one of the controller's accounts ([`Role::Control`]): its P,
+/// I and D parts, or what its thrusters deliver.
+fn controls(f: &dyn Force) -> bool {
+    f.accounts().iter().any(|a| a.role == Role::Control)
 }
 
 impl VesselSystem<'_> {
-    /// Which of the `n` accounts from `base` (one component's) are the controller's, as bits.
-    fn control_bits(&self, base: usize, n: usize) -> u32 {
-        self.control >> base & ((1 << n) - 1)
-    }
-
     /// The quantities the components report at `s` and time `t` ([`super::forces::Force::outputs`]).
     pub fn outputs(&self, s: &VesselState, t: f64) -> Vec<Output> {
         let mut out = Vec::new();
@@ -54,15 +42,15 @@ impl VesselSystem<'_> {
         (0..self.accounts.len())
             .map(|k| {
                 (
-                    booked[k][0].at(&nu, &z[0]) + g.booked[k][0],
-                    booked[k][1].at(&nu, &z[1]) + g.booked[k][1],
+                    booked[k][0].at(&nu, &z[0]) + g.booked(k)[0],
+                    booked[k][1].at(&nu, &z[1]) + g.booked(k)[1],
                 )
             })
             .collect()
     }
 
     /// The controller's force and moment (body frame, about the body origin) at `s` on a step
-    /// that starts at `t`: the sum of [`Self::account_wrenches`] over [`CONTROL_ACCOUNTS`]. The
+    /// that starts at `t`: the sum of [`Self::account_wrenches`] over the accounts of [`Role::Control`]. The
     /// probe runs after every step, at the state the next step starts from: the whole of flow
     /// S2 is assembled (with each account's rows) and kept, and the next step's first sub-step,
     /// when it is S2, uses it (`system/memo.rs`); where it is not S2, the probe assembles the
@@ -74,19 +62,18 @@ impl VesselSystem<'_> {
             let mut g = Forcing::new();
             let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
             for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
-                let mine = self.control_bits(base, f.accounts().len());
-                if mine == 0 {
+                if !controls(f.as_ref()) {
                     continue;
                 }
                 if f.forced() {
                     g.base = base;
                     f.add_forcing(fr, t, &z, &mut g);
                 }
-                for i in 0..f.accounts().len() {
-                    if mine >> i & 1 == 1 {
+                for (i, a) in f.accounts().iter().enumerate() {
+                    if a.role == Role::Control {
                         let k = base + i;
-                        force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked[k][0];
-                        moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked[k][1];
+                        force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked(k)[0];
+                        moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked(k)[1];
                     }
                 }
             }
@@ -100,7 +87,7 @@ impl VesselSystem<'_> {
         let fr = self.frozen(s, on);
         let mut b = S2Builder::new(Some(self.accounts.len()));
         for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
-            if self.control_bits(base, f.accounts().len()) != 0 {
+            if controls(f.as_ref()) {
                 b.base = base;
                 f.add_s2(&fr, &mut b);
             }

@@ -139,7 +139,8 @@ impl VesselSystem<'_> {
         let on = on as usize;
         let minv = self.minv();
         let mut z1 = [[Vector3::zeros(); 3]; 2];
-        let mut work = Work::default();
+        // The ledger's weights of each system's Gramian ([`power_weights`]).
+        let mut weights = [None; 2];
         for sys in [Sys::Trans, Sys::Rot] {
             let k = sys as usize;
             let blocks = &b.sys[k];
@@ -160,7 +161,7 @@ impl VesselSystem<'_> {
             let apply = |x: &SVector<f64, 10>, c: f64| bal.apply_augmented(x, c);
             let dense = || bal.augmented();
             let zb1 = match &b.booked {
-                Some(booked) => {
+                Some(_) => {
                     let (zb1, gram) = affine::flow_action_and_gramian_rows_by::<10, 3, 20>(
                         norm1,
                         apply,
@@ -169,10 +170,7 @@ impl VesselSystem<'_> {
                         h,
                         &[0, 1, 2],
                     );
-                    let w = power_weights(&gram, &scale, &minv[k]);
-                    for acc in 0..self.accounts.len() {
-                        work.0[acc] += self.sign(acc) * energy(&booked[acc][k], &w, k);
-                    }
+                    weights[k] = Some(power_weights(&gram, &scale, &minv[k]));
                     zb1
                 }
                 None => affine::flow_action_by(norm1, apply, dense, &zb, h),
@@ -184,6 +182,12 @@ impl VesselSystem<'_> {
                 z.fixed_rows::<3>(6).into_owned(),
             ];
         }
+        let work = match (&b.booked, weights) {
+            (Some(booked), [Some(wt), Some(wr)]) => Work::from_fn(self.accounts.len(), |acc| {
+                self.sign(acc) * (energy(&booked[acc][0], &wt, 0) + energy(&booked[acc][1], &wr, 1))
+            }),
+            _ => Work::default(),
+        };
         (z1, work)
     }
 }

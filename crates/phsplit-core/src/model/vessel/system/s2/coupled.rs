@@ -263,7 +263,7 @@ impl VesselSystem<'_> {
                                 * scale[j]
                         })
                         .sum::<f64>();
-                    work.0[acc] += self.sign(acc) * energy;
+                    work.add(acc, self.sign(acc) * energy);
                 }
                 zb1
             }
@@ -312,17 +312,17 @@ impl VesselSystem<'_> {
         let forced = self.forced;
         let stateful = self.forced_stateful;
         // The parts of the forcing that depend on time only, once per stage (in `fixed`); the
-        // rest per pass, added to them in `g`.
-        let mut fixed = [Forcing::new(); 3];
+        // parts that depend on the state per pass (in `g`). The stage's forcing is their sum.
+        let mut fixed: [Forcing; 3] = std::array::from_fn(|_| Forcing::new());
         if self.forced_timed {
             for i in 0..s {
                 self.add_forcing_of(fr, t + nodes[i] * h, z0, Some(false), &mut fixed[i]);
             }
         }
-        let mut g = [Forcing::new(); 3];
-        if !stateful {
-            g[..s].copy_from_slice(&fixed[..s]);
-        }
+        let mut g: [Forcing; 3] = std::array::from_fn(|_| Forcing::new());
+        let total = |f: &Forcing, g: &Forcing| -> [Z3; 2] {
+            std::array::from_fn(|k| std::array::from_fn(|c| f.g[k][c] + g.g[k][c]))
+        };
         let mut gt = [[SVector::<f64, 6>::zeros(); 3]; 3];
         let mut stage_z = [*z0; 3];
         let mut ys: [Six; 3] = [zb0; 3];
@@ -336,7 +336,7 @@ impl VesselSystem<'_> {
                 let old = gt;
                 for i in 0..s {
                     if stateful {
-                        g[i] = fixed[i];
+                        g[i].clear();
                         self.add_forcing_of(
                             fr,
                             t + nodes[i] * h,
@@ -345,7 +345,7 @@ impl VesselSystem<'_> {
                             &mut g[i],
                         );
                     }
-                    gt[i] = mul6(&to_six(&g[i].g), &inv);
+                    gt[i] = mul6(&to_six(&total(&fixed[i], &g[i])), &inv);
                 }
                 // After an unrelaxed pass the stages solve the linear stage equations with the
                 // previous forcing, so the residual of the collocation equations at them is
@@ -410,9 +410,9 @@ impl VesselSystem<'_> {
             // The stages are converged to the fixed point's tolerance: the update takes the
             // field and the forcing at them.
             for i in 0..s {
-                g[i] = fixed[i];
+                g[i].clear();
                 self.add_forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true), &mut g[i]);
-                gt[i] = mul6(&to_six(&g[i].g), &inv);
+                gt[i] = mul6(&to_six(&total(&fixed[i], &g[i])), &inv);
                 y1 = axpy(&y1, &axpy(&field(&ys[i]), &gt[i], 1.0), h * bw[i]);
             }
         } else {
@@ -430,7 +430,7 @@ impl VesselSystem<'_> {
             for i in 0..s {
                 let mut p = self.power_at(booked, &stage_z[i]);
                 if forced {
-                    p += self.forcing_power(&g[i], &stage_z[i]);
+                    p += self.forcing_power(&[&fixed[i], &g[i]], &stage_z[i]);
                 }
                 work += p.scaled(h * bw[i]);
             }
