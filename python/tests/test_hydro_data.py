@@ -310,3 +310,14 @@ def test_dp_weather_s_spectral_range_lies_inside_its_dataset_s_frequencies():
     assert w.min() <= waves["omega_range"][0] < waves["omega_range"][1] <= w.max()
     comps = phsplit.load_scenario("dp-weather").vessel.to_dict()["waves"]["frequencies"]
     assert w.min() <= min(comps) and max(comps) <= w.max()
+
+
+def test_complex_values_as_capytaine_returns_them_in_memory_load_the_same():
+    ds = raw()
+    merged = ds.copy()
+    for name in ("excitation_force", "Froude_Krylov_force"):
+        merged[name] = ds[name].sel(complex="re") + 1j * ds[name].sel(complex="im")
+    merged = merged.drop_dims("complex")
+    a = hydro.from_capytaine(ds, symmetric=True)
+    b = hydro.from_capytaine(merged, symmetric=True)
+    assert a["waves"] == b["waves"] and np.array_equal(a["added_mass"], b["added_mass"])

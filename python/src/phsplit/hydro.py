@@ -10,6 +10,9 @@ that file written with ``capytaine.io.xarray.separate_complex_values`` and reope
 * ``added_mass_infinite_frequency``: Capytaine's ``omega = inf`` added mass, when the dataset has
   the variable ``added_mass_infinite_frequency`` (``scripts/gen_capytaine_box.py`` stores it);
 * ``radiation_damping``: ``[frequency][6][6]``, on the frequencies of the transfer functions;
+* ``hydrostatic_stiffness``: the dataset's 6×6 matrix as stored (about its rotation centre, with
+  its centre of mass), and ``reference_point``: the rotation centre, the origin and ``r``;
+* ``checks`` (the checks passed, with the measured values) and ``failed_checks``;
 * the ``[waves]`` table's transfer-function keys: ``rao_frequencies`` (rad/s),
   ``rao_directions`` (degrees), ``force_rao_real`` and ``force_rao_imag`` (``[direction]
   [frequency][dof]``): the excitation force (Froude–Krylov plus diffraction) per metre of wave
