@@ -78,8 +78,11 @@ elliptic-refs: $(VENV)/.deps
 rigid-body-refs: $(VENV)/.deps
 	$(BIN)/python scripts/gen_rigid_body_refs.py
 
-# The stored Capytaine dataset of the tests (python/tests/data/box_barge_capytaine.nc), recomputed
-# with Capytaine in its own environment (it is not a dependency of phsplit).
+# The Capytaine datasets (recomputed, about a minute): the tests' box barge
+# (python/tests/data/box_barge_capytaine.nc, and box_barge_capytaine_cg.nc about its centre of
+# gravity) and dp-weather's box (python/src/phsplit/scenarios/paper_box_capytaine.nc), with
+# Capytaine 3.x (3.0.0 when made) in its own environment: it is not a dependency of phsplit
+# (docs/hydrodynamic-data.md).
 capytaine-box:
 	test -x .venv-capytaine/bin/python || $(PYTHON) -m venv .venv-capytaine
 	.venv-capytaine/bin/python -m pip install --quiet "capytaine>=3,<4"

@@ -1,4 +1,4 @@
-"""Issue 11 (its second part): waves as a port. References: the target spectrum (wavespectra)
+"""Waves as a port. References: the target spectrum (wavespectra)
 against an estimate from a 3-hour elevation record; the heave response to a regular wave against
 the closed-form transfer function of the mass-spring-damper; the independent numpy model
 (tests/reference.py, written again from docs/model.md 5.9) by DOP853; the Capytaine dataset read
@@ -124,25 +124,35 @@ def test_sp2_stays_within_its_passivity_bound_for_an_hour_at_h_1():
 # -- Capytaine --------------------------------------------------------------------------------
 
 def test_the_capytaine_loader_reproduces_capytaines_values():
-    """The stored dataset (scripts/gen_capytaine_box.py, Capytaine 3.0.0): the loader's added mass,
-    excitation force and drift coefficients equal Capytaine's, read here with xarray, exactly (the
-    force as the complex conjugate: e^{-iwt} to e^{+iwt})."""
+    """The stored dataset (scripts/gen_capytaine_box.py, Capytaine 3.0.0), about its rotation
+    centre (the waterline centre): the loader's excitation force and drift coefficients equal
+    Capytaine's, read here with xarray, moved to the centre of gravity 0.5 m above (the force
+    unchanged, exactly; the moment M - r x F, to round-off; the drift, exactly: a vertical move
+    leaves the yaw moment), the force as the complex conjugate (e^{-iwt} to e^{+iwt}); the added
+    mass that moved written again here from the kinematics (v_O = v_G + r x w)."""
     raw = xr.open_dataset(DATA)
-    out = hydro.from_capytaine(DATA)
+    out = hydro.from_capytaine(DATA, symmetric=True)
+    r = raw["center_of_mass"].values - raw["rotation_center"].values
+    assert r.tolist() == [0.0, 0.0, 0.5] and out["reference_point"]["shift"] == r.tolist()
     i = int(np.argmax(raw["omega"].values))
     dofs = ["Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw"]
-    np.testing.assert_array_equal(out["added_mass"],
-                                  raw["added_mass"].isel(omega=i).sel(influenced_dof=dofs, radiating_dof=dofs).values)
+    a = raw["added_mass"].isel(omega=i).sel(influenced_dof=dofs, radiating_dof=dofs).values
+    S = np.array([np.cross(r, e) for e in np.eye(3)]).T
+    moved = np.block([[a[:3, :3], a[:3, :3] @ S + a[:3, 3:]],
+                      [S.T @ a[:3, :3] + a[3:, :3], S.T @ a[:3, :3] @ S + S.T @ a[:3, 3:] + a[3:, :3] @ S + a[3:, 3:]]])
+    np.testing.assert_allclose(out["added_mass"], moved, rtol=1e-12, atol=1e-12 * np.abs(a).max())
     exc = raw["excitation_force"]
     for di, beta in enumerate(raw["wave_direction"].values):
         k = out["waves"]["rao_directions"].index(float(np.degrees(beta)))
         for fi, w in enumerate(raw["omega"].values):
             j = out["waves"]["rao_frequencies"].index(float(w))
-            for n, dof in enumerate(dofs):
-                re = float(exc.sel(complex="re", omega=w, wave_direction=beta, influenced_dof=dof))
-                im = float(exc.sel(complex="im", omega=w, wave_direction=beta, influenced_dof=dof))
-                assert out["waves"]["force_rao_real"][k][j][n] == re
-                assert out["waves"]["force_rao_imag"][k][j][n] == -im
+            x = np.array([complex(float(exc.sel(complex="re", omega=w, wave_direction=beta, influenced_dof=dof)),
+                                  float(exc.sel(complex="im", omega=w, wave_direction=beta, influenced_dof=dof)))
+                          for dof in dofs])
+            want = np.conj(np.concatenate([x[:3], x[3:] - np.cross(r, x[:3])]))
+            got = np.array(out["waves"]["force_rao_real"][k][j]) + 1j * np.array(out["waves"]["force_rao_imag"][k][j])
+            assert np.all(got[:3] == want[:3])
+            np.testing.assert_allclose(got[3:], want[3:], rtol=1e-13, atol=1e-13 * np.abs(x).max())
     # the mean drift (phsplit's drift_force variable, from Capytaine's far field), exactly
     drift = raw["drift_force"]
     for di, beta in enumerate(raw["wave_direction"].values):
@@ -157,7 +167,7 @@ def test_the_capytaine_loader_reproduces_capytaines_values():
     assert float(surge.isel(omega=-1).sel(wave_direction=0.0)) > 0 > float(surge.isel(omega=-1).sel(wave_direction=np.pi))
     assert 0.5 < float(surge.isel(omega=-1).sel(wave_direction=0.0)) / (0.5 * 1025 * 9.81 * 8.0) < 1.5
     # mirrored for a symmetric hull: 270 degrees is 90 with sway, roll and yaw reversed
-    sym = hydro.from_capytaine(DATA, symmetric=True)["waves"]
+    sym = out["waves"]
     a, b = sym["rao_directions"].index(90.0), sym["rao_directions"].index(270.0)
     np.testing.assert_array_equal(np.array(sym["force_rao_real"][b]),
                                   np.array(sym["force_rao_real"][a]) * np.array([1, -1, 1, -1, 1, -1]))
