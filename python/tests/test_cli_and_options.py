@@ -142,7 +142,7 @@ def test_vector_field_binding_matches_the_independent_model():
 
 
 def test_the_compiled_dop853_peer_matches_the_independent_model():
-    """The work-precision study's compiled peer (DOP853 in Rust on the compiled field, issue 17)
+    """The work-precision study's compiled peer (DOP853 in Rust on the compiled field)
     against the numpy model by scipy's DOP853 at rtol 1e-13, across the controller's start, and
     its error falls with its tolerance."""
     from phsplit import _core

@@ -1,4 +1,4 @@
-"""Issue 18: the general vessel of eq. (1), a 6x6 mass matrix M = M_RB + M_A with the centre of
+"""The general vessel of eq. (1), a 6x6 mass matrix M = M_RB + M_A with the centre of
 gravity off the origin, and the offshore supply vessel of Fossen's MSS as a preset.
 
 References: the preset's numbers derived again here from the published inputs of osv.m

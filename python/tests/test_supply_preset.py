@@ -1,4 +1,4 @@
-"""Issue 18: the preset `supply`, the 82.8 m supply vessel of the ShipX data in Fossen's MSS
+"""The preset `supply`, the 82.8 m supply vessel of the ShipX data in Fossen's MSS
 (HYDRO/vessels_shipx/supply/supply.mat; docs/research/mss_vessels.md §3), the paper's vessel with
 its full hydrodynamics.
 

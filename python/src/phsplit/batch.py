@@ -269,7 +269,7 @@ class Sweep:
     def case_id(self, i: int) -> str:
         """``case_<index>_<digest>``, the digest over the case's parameters and :meth:`identity`:
         a rerun with any other setting, vessel or version gets other ids, so the store never
-        hands back a result computed under different conditions (issue 13)."""
+        hands back a result computed under different conditions."""
         key = json.dumps({"case": self.cases[i], **self.identity()}, sort_keys=True, default=repr)
         digest = hashlib.sha256(key.encode()).hexdigest()[:16]
         return f"case_{i:05d}_{digest}"

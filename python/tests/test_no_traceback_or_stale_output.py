@@ -1,8 +1,8 @@
-"""Issue 13: no traceback, no hang, no stale or lost result.
+"""No traceback, no hang, no stale or lost result.
 
 * a fuzz/property pass over the CLI itself (arguments and scenario files);
 * signals at random moments of a long run (SIGINT and SIGTERM; ``PHSPLIT_SIGNAL_RUNS`` runs,
-  default 6 here; the issue's acceptance is 50 in a row: ``PHSPLIT_SIGNAL_RUNS=50``);
+  default 6 here; the acceptance is 50 in a row: ``PHSPLIT_SIGNAL_RUNS=50``);
 * two processes writing the same output;
 * the step-size warning against the vessel's natural periods; one default for control_start.
 """
