@@ -1,9 +1,11 @@
 """Files on disk: opening a phsplit result (:func:`open_dataset`) and writing files whole or not
-at all (:func:`publish`, :func:`temporary_beside`).
+at all (:func:`publish`, :func:`temporary_beside`, :class:`PartialFile`).
 
 Every file phsplit writes is first written under a hidden temporary name in the folder of its
 destination and then renamed into place, so a reader never sees a partial file and Ctrl-C
-leaves the previous file (or none).
+leaves the previous file (or none). A run's output is written through a :class:`PartialFile`:
+the temporary file has a fixed name, ``.<file name>.part``, and is itself locked for the whole run,
+so a second run writing the same output is refused, and nothing but the output stays behind.
 """
 from __future__ import annotations
 
@@ -52,3 +54,69 @@ def temporary_beside(path: str, prefix: str = ".tmp-") -> str:
     os.close(fd)
     return tmp
 
+
+def _lock(fd: int) -> None:
+    """An exclusive lock on the open file ``fd``, without waiting (OSError if it is held). An
+    open-file-description lock where the system has one (Linux): it belongs to this open file
+    alone, so the netCDF library's own ``flock`` on the same file (HDF5 locks a file it writes)
+    and its closing of its own descriptors neither conflict with it nor release it."""
+    import fcntl
+    import struct
+
+    if hasattr(fcntl, "F_OFD_SETLK"):
+        # struct flock: l_type, l_whence, l_start, l_len (0: the whole file), l_pid (0 for OFD locks)
+        fcntl.fcntl(fd, fcntl.F_OFD_SETLK, struct.pack("hhqqi4x", fcntl.F_WRLCK, os.SEEK_SET, 0, 0, 0))
+    else:  # pragma: no cover - systems without OFD locks
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+
+class BusyError(Exception):
+    """Another process is writing the same output right now."""
+
+
+class PartialFile:
+    """The temporary file of an output being written, ``<folder>/.<file name>.part``, locked
+    (exclusively, :func:`_lock`) from creation until it is published or removed: a second process that
+    would write the same output finds it locked and raises :class:`BusyError` before touching
+    anything. :meth:`publish` renames it onto the output; :meth:`discard` removes it. Either
+    drops the lock with the file, so no lock file is left behind. A process that is killed
+    leaves the part file unlocked; the next run of the same output takes it over."""
+
+    def __init__(self, path: str):
+        self.path = path
+        self.part = os.path.join(os.path.dirname(os.path.abspath(path)), f".{os.path.basename(path)}.part")
+        while True:
+            fd = os.open(self.part, os.O_RDWR | os.O_CREAT, 0o600)
+            try:
+                _lock(fd)
+            except OSError:
+                os.close(fd)
+                raise BusyError(path) from None
+            try:
+                same = os.stat(self.part).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            # The file was published or removed between our open and our lock: try again.
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        self._fd = fd
+
+    def publish(self) -> None:
+        """The finished file onto the output, atomically; the lock goes with it."""
+        publish(self.part, self.path)
+        self._close()
+
+    def discard(self) -> None:
+        """Remove the temporary file (nothing is written to the output)."""
+        try:
+            os.unlink(self.part)
+        except FileNotFoundError:
+            pass
+        self._close()
+
+    def _close(self) -> None:
+        if self._fd is not None:
+            os.close(self._fd)
+            self._fd = None

@@ -15,6 +15,17 @@ def presets() -> dict[str, tuple[str, str]]:
     return {n: (d, t) for n, d, t in _core.Vessel.presets()}
 
 
+#: Earlier names of shipped vessels, still accepted: old name -> the preset's name now.
+#: ``supply`` is ``shipx-supply`` (the 82.8 m vessel of MSS's ShipX data; MSS's own
+#: ``supply.m`` is a different, 76.2 m vessel, which the old name suggested).
+PRESET_ALIASES = {"supply": "shipx-supply"}
+
+
+def preset_name(name: str) -> str:
+    """A preset's name now, for its name or an earlier one (:data:`PRESET_ALIASES`)."""
+    return PRESET_ALIASES.get(name, name) if isinstance(name, str) else name
+
+
 class Vessel:
     """A vessel: rigid body, forces and ports (components), default initial state (SI units).
 
@@ -50,10 +61,12 @@ class Vessel:
     @classmethod
     def preset(cls, name: str) -> "Vessel":
         """A shipped vessel by name (``phsplit.presets()`` lists them; ``phsplit vessels``):
-        ``"paper"`` (the paper's, App. D) or ``"osv"`` (the 83 m offshore supply vessel of
-        Fossen's MSS, osv.m: full added mass, CG off the origin). Each number's source is in the
+        ``"paper"`` (the paper's, App. D), ``"osv"`` (the 83 m offshore supply vessel of
+        Fossen's MSS, osv.m: full added mass, CG off the origin) or ``"shipx-supply"`` (the
+        82.8 m supply vessel of MSS's ShipX data; ``"supply"``, its earlier name, still works). Each number's source is in the
         preset's file (``phsplit.presets()[name]``)."""
         found = presets()
+        name = preset_name(name)
         if not isinstance(name, str) or name not in found:
             raise _core.InvalidInputError(
                 f"unknown vessel preset {name!r}; the presets are {', '.join(repr(k) for k in found)}")
