@@ -261,7 +261,7 @@ CATALOGUE: list[Bad] = [
         ("simulation.control_start", "never")),
     Bad("scenario gain that is not a gain", scenario("[control]\nkp_translational = [-1.0, 0.0, 0.0]\n"), E,
         ("control.kp_translational[0]", "≥ 0")),
-    # issue 13: the API
+    # the API
     Bad("save_every given as a boolean", sim(save_every=True), E, ("save_every", "integer")),
     Bad("Euler angles given as text", sim(initial={"euler": "abc"}), E, ("euler", "3 numbers")),
     Bad("time span beyond what doubles resolve", sim(t_span=(1e17, 1e17 + 10.0)), E, ("h", "resolve", "t_span")),
@@ -275,7 +275,7 @@ CATALOGUE: list[Bad] = [
     Bad("scenario t_span to infinity", scenario("[simulation]\nt_span = [0.0, inf]\n"), E, ("t_span", "finite")),
     Bad("scenario save_every as a boolean", scenario("[simulation]\nsave_every = true\n"), P,
         ("save_every", "integer")),
-    # issue 13: the command line (one line on stderr, exit status 2, nothing written outside)
+    # the command line (one line on stderr, exit status 2, nothing written outside)
     Bad("CLI: negative end time", cli(*SIM, "--t-end", "-5"), C, ("t_span", "t1 > t0")),
     Bad("CLI: zero end time", cli(*SIM, "--t-end", "0"), C, ("t_span", "t1 > t0")),
     Bad("CLI: end time shorter than a step", cli(*SIM, "--t-end", "0.1"), C, ("h = 0.5 s", "longer than t_span")),
@@ -310,7 +310,7 @@ CATALOGUE: list[Bad] = [
 ]
 
 CATALOGUE += [
-    # issue 13: more API mistakes, each an InvalidInputError
+    # more API mistakes, each an InvalidInputError
     Bad("method given as None", sim(method=None), E, ("method", "None")),
     Bad("settings that are not a Settings", lambda: phsplit.simulate(phsplit.Vessel.paper(), settings={"h": 1.0}), E,
         ("settings", "phsplit.Settings")),
@@ -324,7 +324,7 @@ CATALOGUE += [
 ]
 
 CATALOGUE += [
-    # issue 15: the FMU exporter
+    # the FMU exporter
     Bad("CLI: FMU file without .fmu", cli("fmu", "export", "-o", "vessel.zip"), C, ("must end in .fmu",)),
     Bad("CLI: FMU binary for an unknown platform", cli("fmu", "export", "-o", "v.fmu", "--binary", "beos=x.so"), C,
         ("binary platform", "linux64", "win64")),
@@ -341,7 +341,7 @@ CATALOGUE += [
 ]
 
 CATALOGUE += [
-    # issue 18: quadratic damping
+    # quadratic damping
     Bad("quadratic damping with 2 coefficients",
         vessel_with("[control]", "[damping_quadratic]\ncoefficients = [1.0, 2.0]\n\n[control]"), E, ("6 numbers",)),
     Bad("quadratic damping with a negative coefficient",
@@ -350,7 +350,7 @@ CATALOGUE += [
 ]
 
 CATALOGUE += [
-    # issue 18: cross-flow drag
+    # cross-flow drag
     Bad("cross-flow drag with the hull's ends reversed",
         vessel_with("[control]", "[crossflow_drag]\ndraft = 4.5\ndrag_coefficient = 1.0\nx_aft = 40.0\nx_fore = -36.0\n\n[control]"),
         E, ("x_aft < x_fore",)),
@@ -361,7 +361,7 @@ CATALOGUE += [
 
 _ROW = "[0.0, 0.0, 0.0, 0.0, 0.0, 0.0]"
 CATALOGUE += [
-    # issue 18: the general mass matrix and the presets
+    # the general mass matrix and the presets
     Bad("added mass that is not symmetric",
         vessel_with("gravity = 9.81", "gravity = 9.81\nadded_mass = [" + ", ".join(
             [_ROW] + ["[0.0, 0.0, 0.0, 0.0, 0.0, 1.0e6]"] + [_ROW] * 4) + "]"), E,
@@ -399,7 +399,7 @@ CATALOGUE += [
         ("nearly singular", "condition number")),
 ]
 
-# issue 12: rate-limited thrusters
+# rate-limited thrusters
 _RATED = ("[thrusters]\nhull_length = 83.0\nhull_beam = 18.0\n"
           "[[thrusters.unit]]\nkind = \"tunnel\"\nposition = [37.0, 0.0, -3.0]\nmax_thrust = 3e5\n{tunnel}"
           "[[thrusters.unit]]\nkind = \"azimuth\"\nposition = [-41.5, 7.0, -3.0]\nmax_thrust = 4.2e5\n{azimuth}"

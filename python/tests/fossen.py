@@ -1,4 +1,4 @@
-"""An independent reference for a general vessel, for the tests (issue 18): Fossen's equations of
+"""An independent reference for a general vessel, for the tests: Fossen's equations of
 motion in the body velocities,
 
     M nu' + C(nu) nu + D nu + d_cf(nu) + g(eta) = tau_pid,    Q' = Q S(w),    x' = Q v,

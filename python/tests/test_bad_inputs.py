@@ -25,7 +25,7 @@ def test_bad_input_gets_a_clear_error(bad):
     for words in bad.must_say:
         assert words in msg, f"{bad.what}: {words!r} missing from: {msg}"
     assert "Traceback" not in msg and "panicked" not in msg
-    # every mistake made through the API or a file is an InvalidInputError (issue 13)
+    # every mistake made through the API or a file is an InvalidInputError
     from bad_inputs import CliError
 
     import phsplit

@@ -142,7 +142,7 @@ def test_vector_field_binding_matches_the_independent_model():
 
 
 def test_the_compiled_dop853_peer_matches_the_independent_model():
-    """The work-precision study's compiled peer (DOP853 in Rust on the compiled field, issue 17)
+    """The work-precision study's compiled peer (DOP853 in Rust on the compiled field)
     against the numpy model by scipy's DOP853 at rtol 1e-13, across the controller's start, and
     its error falls with its tolerance."""
     from phsplit import _core
@@ -186,7 +186,7 @@ def test_sigterm_during_simulate_leaves_a_valid_file_with_the_steps_so_far(tmp_p
                           "--t-end", "400000", "--h", "0.05", "--save-every", "200", "--linear-flow", "gauss"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     name = "fig2-h0.05-t400000-s200-gauss"  # the command-line options are in the name
-    parts = lambda: list(tmp_path.glob(f".{name}.*.nc.part"))  # noqa: E731 - unique per run
+    parts = lambda: list(tmp_path.glob(f".{name}.nc.part"))  # noqa: E731 - the locked temporary file
     deadline = time.monotonic() + 120
     while not parts():
         assert p.poll() is None, p.communicate()

@@ -1,4 +1,4 @@
-"""Issue 18 (its second part): cross-flow drag by strip theory (Fossen, Handbook of Marine Craft
+"""Cross-flow drag by strip theory (Fossen, Handbook of Marine Craft
 Hydrodynamics and Motion Control, 2nd ed., 2021, §6.4.3), on the sway velocity relative to the
 water. References: the independent numpy model (tests/reference.py, its strip integrals by scipy's
 quad) by DOP853, a closed form (the terminal sway speed under a constant force), and the ledger."""

@@ -1,4 +1,4 @@
-"""Issue 11 (its first part): a uniform ocean current, through the relative velocity in the
+"""A uniform ocean current, through the relative velocity in the
 damping. References: closed forms (steady drift with the current; the integral action that
 holds position against it) and the independent numpy model (tests/reference.py) by DOP853."""
 from __future__ import annotations

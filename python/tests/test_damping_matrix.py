@@ -1,4 +1,4 @@
-"""Issue 18 (its third part): a full 6x6 linear damping matrix D_L (Fossen's handbook, §6.4),
+"""A full 6x6 linear damping matrix D_L (Fossen's handbook, §6.4),
 symmetric positive semidefinite, as a vessel may have it with the sway-yaw couplings Y_r, N_v.
 References: the paper's vessel written with its diagonal as a matrix (the same numbers), the
 independent numpy model (tests/reference.py) by DOP853, and the ledger."""

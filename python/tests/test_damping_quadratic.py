@@ -1,4 +1,4 @@
-"""Issue 18 (its first part): quadratic hydrodynamic damping, Fossen's diagonal D_n(nu) nu
+"""Quadratic hydrodynamic damping, Fossen's diagonal D_n(nu) nu
 (Handbook of Marine Craft Hydrodynamics and Motion Control, 2nd ed., 2021, §6.4), on the velocity
 relative to the water. References: the independent numpy model (tests/reference.py) by DOP853, a
 closed form (the terminal speed under a constant force), and the ledger's own balance."""

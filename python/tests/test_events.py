@@ -1,4 +1,4 @@
-"""Issue 14 (in part): output at chosen times and events, against independent references
+"""Output at chosen times and events, against independent references
 (tests/reference.py: eq. (39) in numpy, scipy DOP853 at tight tolerance, no phsplit code)."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The vessel as an FMI 2.0 co-simulation FMU (issue 15; docs/fmu.md), run in the hosts the
+"""The vessel as an FMI 2.0 co-simulation FMU (docs/fmu.md), run in the hosts the
 industry uses: FMPy (validation, simulation, the low-level slave API) and OSP's libcosim through
 libcosimpy. The references are phsplit.simulate on the same vessel and settings (the FMU must give
 its numbers) and, for the coupled run, FMPy fed with the load written out here."""

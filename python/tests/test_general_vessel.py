@@ -1,4 +1,4 @@
-"""Issue 18: the general vessel of eq. (1), a 6x6 mass matrix M = M_RB + M_A with the centre of
+"""The general vessel of eq. (1), a 6x6 mass matrix M = M_RB + M_A with the centre of
 gravity off the origin, and the offshore supply vessel of Fossen's MSS as a preset.
 
 References: the preset's numbers derived again here from the published inputs of osv.m
@@ -257,14 +257,14 @@ def test_the_presets_on_the_command_line_and_in_scenarios(tmp_path, capsys):
     assert cli.main(["simulate", "--vessel", "osv", "--t-end", "10", "--out", str(tmp_path), "--no-plot"]) == 0
     import xarray as xr
 
-    with xr.open_dataset(tmp_path / "fig2-osv-t10.nc") as ds:
+    with xr.open_dataset(tmp_path / "osv-t10.nc") as ds:  # named after its vessel
         # the body velocities are M^-1 (p, m) with the general M
         u = np.hstack([ds["linear_momentum"].values, ds["angular_momentum"].values])
         nu = np.linalg.solve(OSV.mass_matrix, u.T).T
         np.testing.assert_allclose(ds["velocity"].values, nu[:, :3], rtol=1e-10, atol=1e-14)
         np.testing.assert_allclose(ds["angular_velocity"].values, nu[:, 3:], rtol=1e-10, atol=1e-16)
     assert cli.main(["simulate", "--vessel", "osw", "--out", str(tmp_path)]) == 2
-    assert "neither a file nor a shipped vessel (shipped: paper, osv, supply)" in capsys.readouterr().err
+    assert "neither a file nor a shipped vessel (shipped: paper, osv, shipx-supply)" in capsys.readouterr().err
 
 
 def test_a_vessel_file_with_full_matrices_in_a_scenario(tmp_path):

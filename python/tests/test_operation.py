@@ -1,4 +1,4 @@
-"""Issue 12 (its first part): the pipe on the stinger as a port, and moving set points through
+"""The pipe on the stinger as a port, and moving set points through
 Fossen's third-order reference model. References: closed forms (the catenary, solved here with
 mpmath at 30 digits; the filter's step response by partial fractions), a published example
 (MIT OCW 2.019, 2011), the static balance of the controller and the pipe, and the independent
@@ -369,7 +369,7 @@ def test_the_offset_from_the_route_is_split_across_and_along():
     assert np.abs(o["route_cross_track"]).max() > 1e-3  # the vessel does leave the route
 
 
-# -- from the review of this session ------------------------------------------------------------
+# -- from a review ------------------------------------------------------------
 
 def test_a_heading_table_across_pi_turns_the_short_way():
     """Headings 3.1 then -3.1 rad: a turn of 0.083 rad through pi, not of 6.2 rad; the heading

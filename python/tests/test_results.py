@@ -1,4 +1,4 @@
-"""Issue 14 (in part): files people can use. Every NetCDF file phsplit writes passes the IOOS
+"""Files people can use. Every NetCDF file phsplit writes passes the IOOS
 compliance checker's CF-1.8 test with no errors and no warnings; a file records what reruns it,
 and `phsplit rerun` reproduces it to the last bit; `phsplit.open_dataset` round-trips every
 variable and attribute."""

@@ -1,6 +1,6 @@
 """phsplit.rigid_body against mpmath (the core's checked-in table, written by
 scripts/gen_rigid_body_refs.py: closed form at 50 digits, checked against mpmath's ODE solver at
-30 digits), invariants, and the middle-axis input of issue 16."""
+30 digits), invariants, and an input next to the middle axis."""
 from __future__ import annotations
 
 import csv
@@ -50,7 +50,7 @@ def test_exact_momentum_within_four_times_the_problems_sensitivity():
     assert worst <= 1.0
 
 
-def test_issue16_middle_axis_input():
+def test_an_input_next_to_the_middle_axis():
     # T = (1, 2, 3), m0 = (1e-7, 1, 2e-7), k'^2 = 1.3e-14; mpmath ODE (30 digits). The third
     # component was 1.76977477e-7 at t = 0.5 (error 2.3e-11 |m|), off by 1.9e-5 |m| at t = 50.
     body = FreeRigidBody([1.0, 2.0, 3.0])

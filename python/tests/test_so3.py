@@ -1,4 +1,4 @@
-"""phsplit.so3: gimbal lock (issue 16), round trips over SO(3), agreement with scipy's Rotation,
+"""phsplit.so3: gimbal lock, round trips over SO(3), agreement with scipy's Rotation,
 vectorisation and errors."""
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ GIMBAL = np.array([
 ])
 
 
-def test_issue16_gimbal_lock():
+def test_gimbal_lock():
     # was (0, 1.5708, -0.98279), rebuilding a matrix 0.385 away; scipy: (0, pi/2, -1.4)
     e = so3.euler_zyx(GIMBAL)
     np.testing.assert_allclose(e, [0.0, np.pi / 2, -1.4], atol=1e-15)

@@ -1,4 +1,4 @@
-"""phsplit.special against mpmath, Boost.Math's table inputs, scipy and the inputs of issue 16.
+"""phsplit.special against mpmath, Boost.Math's table inputs, scipy and the inputs next to the edges of the domain.
 
 The mpmath values are the core's checked-in tables (``crates/phsplit-core/tests/data``, written
 by ``scripts/gen_elliptic_refs.py``); a few random inputs are also evaluated with mpmath here.
@@ -45,11 +45,11 @@ def ellint_table() -> dict[str, np.ndarray]:
 
 
 def jacobi_allowance(u, m, ref):
-    """Issue 16: 8 ulp, or 4 eps |u| (scaled by the slope bound max(1, |m|) outside [0, 1])."""
+    """The documented bound: 8 ulp, or 4 eps |u| (scaled by the slope bound max(1, |m|) outside [0, 1])."""
     return np.maximum(8 * ulp(ref), 4 * EPS * np.abs(u) * np.maximum(1.0, np.abs(m)))
 
 
-def test_issue16_inputs_next_to_m_equal_one():
+def test_inputs_next_to_m_equal_one():
     # values: mpmath, 50 digits
     cases = [
         (709.0, 0.9990000000000001, (-0.9757020098565539, -0.21910177535082018, 0.2212636038166225)),
@@ -120,7 +120,7 @@ def test_agrees_with_scipy_where_scipy_is_accurate_and_beats_it_where_not():
     bound phsplit agrees with it to the sum of the two errors, and wherever scipy misses it
     phsplit is closer to mpmath. Where scipy misses (measured on these tables): NaN for
     ``m = 1 - 1e-10 ... 1 - 2**-53`` from ``|u| ~ 375`` on (its expansion about m = 1 overflows,
-    as phsplit's did before issue 16), and errors growing like ``eps |u|`` beyond the bound at
+    as phsplit's did before the edges were handled), and errors growing like ``eps |u|`` beyond the bound at
     large ``|u|`` (no argument reduction: ``sn(1e15 | 0.5)`` is off by 5e-3)."""
     t = jacobi_table()
     inside = (t["m"] >= 0) & (t["m"] <= 1)

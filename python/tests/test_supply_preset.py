@@ -1,4 +1,4 @@
-"""Issue 18: the preset `supply`, the 82.8 m supply vessel of the ShipX data in Fossen's MSS
+"""The preset `shipx-supply` (earlier name `supply`), the 82.8 m supply vessel of the ShipX data in Fossen's MSS
 (HYDRO/vessels_shipx/supply/supply.mat; docs/research/mss_vessels.md §3), the paper's vessel with
 its full hydrodynamics.
 
@@ -16,7 +16,7 @@ import pytest
 import fossen
 import phsplit
 
-SUPPLY = phsplit.Vessel.preset("supply")
+SUPPLY = phsplit.Vessel.preset("shipx-supply")
 FLIP = np.diag([1.0, -1.0, -1.0, 1.0, -1.0, -1.0])  # Fossen's z down, y starboard -> z up, y port
 MASS = 6362208.5  # main.m, kg
 
@@ -115,8 +115,8 @@ def test_orders_against_fossens_equations(method, order, hs):
 
 def test_the_preset_is_listed_and_runs_from_the_command_line(tmp_path, capsys):
     from phsplit import cli
-    assert "supply" in phsplit.presets()
+    assert "shipx-supply" in phsplit.presets()
     assert cli.main(["vessels"]) == 0
-    assert "supply" in capsys.readouterr().out
-    assert cli.main(["simulate", "--vessel", "supply", "--t-end", "20", "--out", str(tmp_path), "--no-plot"]) == 0
-    assert (tmp_path / "fig2-supply-t20.nc").exists()
+    assert "shipx-supply" in capsys.readouterr().out
+    assert cli.main(["simulate", "--vessel", "shipx-supply", "--t-end", "20", "--out", str(tmp_path), "--no-plot"]) == 0
+    assert (tmp_path / "shipx-supply-t20.nc").exists()

@@ -133,7 +133,7 @@ def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
         assert list(s["status"].values) == ["completed"] * 12
 
 
-# Issue 13, item 1: a case's identity covers everything that determines its result.
+# A case's identity covers everything that determines its result.
 OTHER_VALUE = {"t_span": (0.0, 20.0), "h": 0.25, "method": "rk4", "control_start": None, "outer": "conservative",
                "save_every": 5, "linear_flow": "exact", "ledger": False, "project_invariants": False}
 
@@ -161,7 +161,7 @@ def test_every_setting_vessel_and_version_enters_the_case_id(monkeypatch):
 
 
 def test_a_sweep_rerun_with_other_settings_recomputes_every_case(tmp_path):
-    """The failure of issue 13: sp2 on [0, 100], then rk4 on [0, 20] in the same store."""
+    """A store reused with other settings: sp2 on [0, 100], then rk4 on [0, 20] in the same store."""
     f = tmp_path / "gains.toml"
     f.write_text(SWEEP_TOML.format(t_end=100.0, h=0.5).replace("[-1.0, 6e6, 7e6]", "[6e6]"))
     store = tmp_path / "gains.store"
@@ -179,7 +179,7 @@ def test_a_sweep_rerun_with_other_settings_recomputes_every_case(tmp_path):
 
 
 def test_the_yaw_error_is_wrapped():
-    """Issue 14: a set point at +3.1 rad reached from the other side (-3.1 rad) is 0.083 rad away."""
+    """A set point at +3.1 rad reached from the other side (-3.1 rad) is 0.083 rad away."""
     from phsplit.batch import summarize
 
     d = phsplit.Vessel.paper().to_dict()
@@ -191,7 +191,7 @@ def test_the_yaw_error_is_wrapped():
 
 
 def test_summary_peaks_cover_every_step_not_only_the_saved_ones():
-    """Issue 14: with every 50th state saved, the summary's peak force is still the peak over
+    """With every 50th state saved, the summary's peak force is still the peak over
     every step (the run that saves every step, computed independently from its saved states)."""
     from phsplit.batch import summarize
 

@@ -1,4 +1,4 @@
-"""Issue 12: thrust and azimuth rate limits (docs/model.md §5.8). What rate-limited thrusters
+"""Thrust and azimuth rate limits (docs/model.md §5.8). What rate-limited thrusters
 deliver is a memory the state carries from step to step. Checked here: the limits hold at every
 step while they bind; a ramp from rest matches its closed form; limits that never bind change
 nothing; a run cut into calls, or continued from a saved state, is the same run; the ledger

@@ -1,4 +1,4 @@
-"""Issue 11 (its third part): wind as a port. References: closed forms (the controller's integral
+"""Wind as a port. References: closed forms (the controller's integral
 action holding the vessel against a steady wind; the Harris spectrum's variance), the published
 NPD turbulence intensity, and the independent numpy model (tests/reference.py) by DOP853."""
 from __future__ import annotations

@@ -33,7 +33,7 @@ impl Default for Settings {
     /// The paper's Fig. 2 run: SP4, h = 0.5 s on [0, 200] s, the controller from t = 50 s
     /// (paper §4), S2 outermost, every step saved, the ledger on; flow S2 by Gauss collocation,
     /// which reached every accuracy of the work-precision study 2 to 8 times sooner than the
-    /// exact flow with SP4 and SP6 (README, issue 17). The paper's own scheme, the exact S2
+    /// exact flow with SP4 and SP6 (README). The paper's own scheme, the exact S2
     /// (§3.4.2), is `linear_flow = "exact"`: the Fig. 2 scenario and the reproduction pin it.
     fn default() -> Self {
         Self {

@@ -10,6 +10,12 @@ systems*, Multibody System Dynamics 44 (2018) 251–275, on a Rust core.
 """
 from __future__ import annotations
 
+import time as _time
+
+#: When the package was imported: the start of a ``phsplit`` command, whose summary reports the
+#: whole command's time from here.
+_STARTED = _time.perf_counter()
+
 
 def _early_signal(signum, frame):  # pragma: no cover - exercised by the CLI's signal test
     import os
@@ -45,7 +51,7 @@ from ._core import (
     __version__,
 )
 from ._core import method_info as _method_info
-from . import events, results, rigid_body, so3, special
+from . import events, hydro, results, rigid_body, sea, so3, special
 from .batch import simulate_many, with_parameters
 from .results import open_dataset, open_sweep, rerun
 from .scenario import Scenario
@@ -73,6 +79,7 @@ __all__ = [
     "Vessel",
     "__version__",
     "events",
+    "hydro",
     "load_scenario",
     "method_info",
     "open_dataset",
@@ -81,6 +88,7 @@ __all__ = [
     "rerun",
     "results",
     "rigid_body",
+    "sea",
     "simulate",
     "simulate_many",
     "so3",

@@ -71,7 +71,7 @@ def integrate(
 def method_info(name: str) -> dict[str, Any]: ...
 def euler_zyx(q: list[list[float]]) -> list[float]: ...
 
-# Numerics of the core (issue 16), wrapped with numpy broadcasting in phsplit.special,
+# Numerics of the core, wrapped with numpy broadcasting in phsplit.special,
 # phsplit.rigid_body and phsplit.so3. Every array here is flat float64.
 _F = npt.NDArray[np.float64]
 

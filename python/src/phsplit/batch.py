@@ -26,22 +26,25 @@ sections and keys of a vessel file).
 """
 from __future__ import annotations
 
-import concurrent.futures as cf
+import concurrent.futures as futures
 import hashlib
 import itertools
 import json
 import math
 import os
 import re
-import tempfile
 import time
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from . import _core
-from .simulate import Settings, Vessel, settings_to_toml, simulate
+from . import _core, cf
+from . import scenario as scn
+from .settings import Settings, settings_to_toml
+from .sweepstore import (_coord_name, _stackable, _summary_row, _write_batch, _write_case,
+                         done_cases, remove_temporaries, store_index, write_summary, write_sweep_file)
+from .vessel import Vessel
 
 _PATH = re.compile(r"^([a-z_]+)((?:\.[a-z_]+|\[[0-9]+\])+)$")
 _SEGMENT = re.compile(r"\.([a-z_]+)|\[([0-9]+)\]")
@@ -172,10 +175,6 @@ def summarize(vessel: Vessel, sol) -> dict[str, Any]:
     }
 
 
-def _coord_name(key: str) -> str:
-    return key.replace(".", "_").replace("[", "_").replace("]", "")
-
-
 def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = None,
                   settings: Settings | None = None, max_workers: int | None = None, **kw):
     """Run every case (a mapping of parameter paths to values) on a thread pool; the core releases
@@ -203,7 +202,7 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
         sol = settings.run(v, running_max=True)  # peaks over every step
         return sol, {**summarize(v, sol), "error": sol.failure or ""}
 
-    with cf.ThreadPoolExecutor(max_workers=max_workers or os.cpu_count() or 2) as pool:
+    with futures.ThreadPoolExecutor(max_workers=max_workers or os.cpu_count() or 2) as pool:
         results = list(pool.map(one, cases))
     t = next((s.t for s, _ in results if s is not None and s.status == "completed"), None)
     if t is None:
@@ -240,11 +239,9 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
     ds["diverged"] = ("case", np.array([bool(r.get("diverged", True)) for _, r in results]))
     ds["status"] = ("case", np.array([r["status"] for _, r in results], dtype=object))
     ds["error"] = ("case", np.array([r.get("error", "") for _, r in results], dtype=object))
-    from .results import cf_finish
-
-    ds["time"].attrs.update({"units": "seconds since 1970-01-01 00:00:00", "standard_name": "time", "axis": "T",
+    ds["time"].attrs.update({"units": cf.TIME_UNITS, "standard_name": "time", "axis": "T",
                              "long_name": "simulated time (t = 0 at the nominal epoch)"})
-    return cf_finish(ds, "phsplit simulate_many: one run per case", "simulate_many")
+    return cf.finish(ds, "phsplit simulate_many: one run per case", "simulate_many")
 
 
 # ------------------------------------------------------------------------------------------
@@ -269,7 +266,7 @@ class Sweep:
     def case_id(self, i: int) -> str:
         """``case_<index>_<digest>``, the digest over the case's parameters and :meth:`identity`:
         a rerun with any other setting, vessel or version gets other ids, so the store never
-        hands back a result computed under different conditions (issue 13)."""
+        hands back a result computed under different conditions."""
         key = json.dumps({"case": self.cases[i], **self.identity()}, sort_keys=True, default=repr)
         digest = hashlib.sha256(key.encode()).hexdigest()[:16]
         return f"case_{i:05d}_{digest}"
@@ -287,8 +284,6 @@ def load_sweep(path: str) -> Sweep:
     ``samples`` cases drawn with ``seed``."""
     import difflib
     import tomllib
-
-    from . import scenario as scn
 
     try:
         with open(path, "rb") as f:
@@ -369,55 +364,6 @@ def _run_case(base_tables: dict, settings: Settings, case: dict, store: str | No
     return result
 
 
-def _summary_row(cid: str, case: dict, summary: dict, status: str, error: str) -> dict:
-    """A case's row of the sweep's summary table."""
-    return {"case_id": cid, **case, **summary, "status": status, "error": error}
-
-
-def _store_file(ds, path: str, encoding: dict) -> None:
-    """Write ``ds`` to ``path`` atomically: a temporary file beside it, then a rename, so a store
-    holds a file whole or not at all."""
-    import dask
-
-    from .plotting import publish
-
-    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".tmp-", suffix=".nc")
-    os.close(fd)
-    try:
-        # The dataset is in memory: no dask scheduler is involved. Said explicitly, so that on a
-        # Dask worker xarray takes a local lock, not a distributed one (a round trip to the
-        # scheduler per write made writing on the workers 7 times slower).
-        with dask.config.set(scheduler="synchronous"):
-            ds.to_netcdf(tmp, encoding=encoding)
-        publish(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-
-
-def _write_case(store: str, cid: str, result: dict) -> dict:
-    """Write one case atomically: STORE/cases/<cid>.nc via a temporary file and a rename.
-    Returns the case's summary row (as :func:`write_summary` would read it back)."""
-    import xarray as xr
-
-    ds = result.get("dataset")
-    if ds is None:  # an invalid case: no run, only what was asked and why it was refused
-        from .results import cf_finish
-
-        ds = cf_finish(xr.Dataset(), "phsplit sweep case (not run)", "sweep")
-    ds = ds.copy()
-    ds.attrs.update({"case_id": cid, "case_status": result["status"], "case_error": result.get("error", ""),
-                     "case_parameters": json.dumps(result["case"], sort_keys=True),
-                     "case_summary": json.dumps(result.get("summary", {}), sort_keys=True)})
-    # A case file is written once: each variable along the record dimension in one HDF5 chunk
-    # (netCDF's default chunk of one record made writing 2.2x as slow, the file 2.1x as large).
-    _store_file(ds, os.path.join(store, "cases", f"{cid}.nc"),
-                {k: {"chunksizes": ds[k].shape} for k in ds.data_vars if "time" in ds[k].dims and ds[k].size})
-    a = ds.attrs
-    return _summary_row(cid, json.loads(a["case_parameters"]), json.loads(a["case_summary"]),
-                        a["case_status"], a["case_error"])
-
-
 #: Most cases in one task and one file of a sweep store (a *batch*; :func:`_batch_size`).
 MAX_BATCH = 32
 
@@ -461,136 +407,6 @@ def _run_cases(base_tables: dict, settings: Settings, cases: list[dict], store: 
     return results
 
 
-def _stackable(results: list[dict]) -> bool:
-    """Whether the cases that ran have the same variables, of the same dimensions and sizes
-    beyond time, all floating point (a parameter can add an account, or the rate-limited
-    thrusters' memory to the initial state): else each case gets a file of its own."""
-    done = [r["dataset"] for r in results if r.get("dataset") is not None]
-    if not done:
-        return True
-
-    def shape(d):
-        return {k: (v.dims, tuple(n for dim, n in zip(v.dims, v.shape) if dim != "time"), v.dtype.kind)
-                for k, v in d.variables.items() if k != "time"}
-
-    first = shape(done[0])
-    return all(kind in "f" or k in done[0].coords for k, (_, _, kind) in first.items()) and all(
-        shape(d) == first for d in done[1:])
-
-
-#: The per-case attributes of a case file that a batch file holds as variables along ``case``.
-_CASE_ATTRS = ("case_status", "case_error", "case_parameters", "case_summary")
-
-
-def _batch_dataset(cids: list[str], results: list[dict]):
-    """The cases of one task stacked along ``case``: every variable of the case files with a
-    leading ``case`` dimension (NaN beyond a case's last saved time and for a case that did not
-    run), ``case_id`` as a coordinate, the case files' own attributes (status, error, parameters,
-    summary) as variables along ``case``, and each run attribute that differs between the cases
-    (the vessel file with its parameters, the number of steps, ...) as a variable
-    ``run_<attribute>`` (empty for a case that did not run); the attributes the cases that ran
-    share stay global."""
-    import xarray as xr
-
-    n = len(results)
-    ran = [r.get("dataset") for r in results]
-    done = [d for d in ran if d is not None]
-    ref = max(done, key=lambda d: d.sizes.get("time", 0)) if done else None
-    variables: dict[str, Any] = {}
-    coords: dict[str, Any] = {"case_id": ("case", np.array(cids, dtype=object), {"long_name": "case identifier"})}
-    attrs: dict[str, Any] = {}
-    if ref is not None:
-        for name, c in ref.coords.items():
-            coords[name] = c.variable
-        names = list(dict.fromkeys(k for d in done for k in d.data_vars))
-        for name in names:
-            # Variables, not DataArrays: building a DataArray per case and name cost 30 ms a batch.
-            proto = next(d.variables[name] for d in done if name in d.data_vars)
-            shape = tuple(ref.sizes[k] if k == "time" else proto.sizes[k] for k in proto.dims)
-            out = np.full((n,) + shape, np.nan)
-            for i, d in enumerate(ran):
-                if d is not None and name in d.data_vars:
-                    a = np.asarray(d.variables[name].values, dtype=float)
-                    out[(i,) + tuple(slice(0, k) for k in a.shape)] = a
-            variables[name] = (("case",) + proto.dims, out, dict(proto.attrs))
-        keys = list(dict.fromkeys(k for d in done for k in d.attrs))
-        for k in keys:
-            vals = [d.attrs.get(k) if d is not None else None for d in ran]
-            if all(k in d.attrs and str(d.attrs[k]) == str(ref.attrs.get(k)) for d in done):
-                attrs[k] = ref.attrs[k]  # the same for every case that ran
-            else:
-                variables[f"run_{k}"] = ("case", np.array(["" if v is None else str(v) for v in vals], dtype=object),
-                                         {"long_name": f"the run attribute {k} of each case"})
-    rows = [d.sizes.get("time", 0) if d is not None else 0 for d in ran]
-    variables["case_time_count"] = ("case", np.array(rows, dtype=np.int32),
-                                    {"long_name": "number of saved times of each case (the rest is padding)"})
-    for k, key in zip(_CASE_ATTRS, ("status", "error", "case", "summary")):
-        if key in ("case", "summary"):
-            vals = [json.dumps(r.get(key, {}), sort_keys=True) for r in results]
-        else:
-            vals = [str(r.get(key, "")) for r in results]
-        variables[k] = ("case", np.array(vals, dtype=object), {"long_name": k.replace("_", " ")})
-    from .results import cf_finish
-
-    ds = xr.Dataset(variables, coords=coords, attrs=attrs)
-    ds = cf_finish(ds, attrs.get("title", "phsplit sweep cases"), "sweep")
-    ds.attrs["phsplit_batch"] = f"{n} cases of a sweep along 'case' (phsplit.open_sweep reads the store)"
-    return ds
-
-
-def _write_batch(store: str, cids: list[str], results: list[dict]) -> list[dict]:
-    """Write one task's cases as one file, atomically: ``STORE/cases/batch_<digest>.nc`` (the
-    digest over the case ids), via a temporary file and a rename. Returns their summary rows."""
-    ds = _batch_dataset(cids, results)
-    name = "batch_" + hashlib.sha256("\n".join(cids).encode()).hexdigest()[:16] + ".nc"
-    # Each variable in one HDF5 chunk (as a case file). Text as character arrays:
-    # variable-length strings in a file that is opened twice at once (open_sweep and the store's
-    # index) broke HDF5's reads (a review reproduced it).
-    encoding = {k: {"chunksizes": ds[k].shape} for k in ds.data_vars if ds[k].dtype.kind == "f" and ds[k].size}
-    encoding.update({k: {"dtype": "S1"} for k in ds.variables if ds[k].dtype.kind in "OU"})
-    _store_file(ds, os.path.join(store, "cases", name), encoding)
-    # The rows as write_summary reads them back from the file (the JSON's sorted keys).
-    meta = {k: [str(x) for x in ds[k].values] for k in _CASE_ATTRS}
-    return [_summary_row(cid, json.loads(meta["case_parameters"][i]), json.loads(meta["case_summary"][i]),
-                         meta["case_status"][i], meta["case_error"][i]) for i, cid in enumerate(cids)]
-
-
-def store_index(store: str) -> dict[str, tuple[str, int | None]]:
-    """Where each stored case of a sweep store is: ``{case id: (file, index along case)}``, the
-    index ``None`` for a file of one case (``cases/<id>.nc``), else its place in a batch file
-    (``cases/batch_<digest>.nc``). A case stored twice (two sweeps writing one store at once) is
-    taken from the first file in name order."""
-    import xarray as xr
-
-    d = os.path.join(store, "cases")
-    out: dict[str, tuple[str, int | None]] = {}
-    if not os.path.isdir(d):
-        return out
-    for f in sorted(os.listdir(d)):
-        if f.startswith(".") or not f.endswith(".nc"):
-            continue
-        p = os.path.join(d, f)
-        if f.startswith("batch_"):
-            try:
-                # Through xarray, as every other read of the store: its cache of open files
-                # and netCDF4 handles of its own on one file do not mix (a crash in HDF5).
-                with xr.open_dataset(p, decode_times=False) as nc:
-                    ids = [str(x) for x in nc["case_id"].values]
-            except (OSError, ValueError, KeyError) as e:
-                raise _core.InvalidInputError(f"{p!r} is not a batch file of a sweep store that phsplit can read: "
-                                              f"{e}; remove it and run the sweep again to compute its cases") from None
-            for i, cid in enumerate(ids):
-                out.setdefault(cid, (p, i))
-        else:
-            out.setdefault(f[:-3], (p, None))
-    return out
-
-
-def done_cases(store: str) -> set[str]:
-    """The ids of the cases a sweep store holds (in files of one case or in batch files)."""
-    return set(store_index(store))
-
-
 def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers: int | None = None,
               progress: bool = True, retries: int = 3) -> dict[str, Any]:
     """Run the missing cases of ``sweep`` on Dask and store them; returns counts and the summary
@@ -599,20 +415,12 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
     from tqdm import tqdm
 
     os.makedirs(os.path.join(store, "cases"), exist_ok=True)
-    for f in os.listdir(os.path.join(store, "cases")):
-        if f.startswith(".tmp-"):
-            os.unlink(os.path.join(store, "cases", f))  # left by a client that was killed mid-write
+    remove_temporaries(store)  # left by a client that was killed mid-write
     ids = [sweep.case_id(i) for i in range(len(sweep.cases))]
     have = done_cases(store)  # cases of other settings stay in the store under their own ids, unused
     todo = [i for i, cid in enumerate(ids) if cid not in have]
     workers = n_workers or os.cpu_count() or 2
-    from .plotting import publish
-
-    fd, tmp = tempfile.mkstemp(dir=store, prefix=".tmp-", suffix=".json")
-    with os.fdopen(fd, "w") as f:
-        json.dump({"name": sweep.name, **sweep.identity(), "cases": dict(zip(ids, sweep.cases))},
-                  f, indent=1, default=repr)
-    publish(tmp, os.path.join(store, "sweep.json"))  # whole or not at all
+    write_sweep_file(store, {"name": sweep.name, **sweep.identity(), "cases": dict(zip(ids, sweep.cases))})
     cluster = None
     rows: dict[str, dict] = {}  # the summary rows of the cases computed now
     lost: list[str] = []  # cases whose task failed outside the case: not stored
@@ -666,57 +474,10 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
             client.close()
             if cluster is not None:
                 cluster.close()
-                # a worker killed while writing a case leaves its temporary file
-                for f in os.listdir(os.path.join(store, "cases")):
-                    if f.startswith(".tmp-"):
-                        os.unlink(os.path.join(store, "cases", f))
+                remove_temporaries(store)  # a worker killed while writing a case leaves its temporary file
     elapsed = time.perf_counter() - t0
     summary = write_summary(store, ids, rows)
     return {"cases": len(ids), "computed": len(todo) - len(lost), "reused": len(ids) - len(todo), "lost": len(lost),
             "seconds": elapsed, "summary": summary}
 
 
-def write_summary(store: str, ids: list[str], known: dict[str, dict] | None = None) -> str:
-    """One row per case: parameters, summary, status and error; as CSV and NetCDF. The rows of
-    ``known`` (by case id, as :func:`_write_case` returns them) are used as given; the other
-    cases' rows are read from their files in the store."""
-    import csv
-
-    import xarray as xr
-
-    rows = []
-    index = store_index(store) if not known or any(cid not in known for cid in ids) else {}
-    batches: dict[str, dict[str, list[str]]] = {}  # a batch file's metadata, read once
-    for cid in ids:
-        if known and cid in known:
-            rows.append(known[cid])
-            continue
-        path, i = index[cid]
-        if i is None:
-            with xr.open_dataset(path) as ds:
-                a = {k: ds.attrs[k] for k in _CASE_ATTRS}
-        else:
-            if path not in batches:
-                with xr.open_dataset(path) as ds:
-                    batches[path] = {k: [str(x) for x in ds[k].values] for k in _CASE_ATTRS}
-            a = {k: v[i] for k, v in batches[path].items()}
-        rows.append(_summary_row(cid, json.loads(a["case_parameters"]), json.loads(a["case_summary"]),
-                                 a["case_status"], a["case_error"]))
-    cols = list(dict.fromkeys(k for r in rows for k in r))
-    path = os.path.join(store, "summary.csv")
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=cols)
-        w.writeheader()
-        w.writerows(rows)
-    data = {}
-    for c in cols:
-        vals = [r.get(c, math.nan) for r in rows]
-        if all(isinstance(v, (int, float, bool)) for v in vals):
-            data[_coord_name(c)] = ("case", np.asarray(vals, float))
-        else:
-            data[_coord_name(c)] = ("case", np.asarray([str(v) for v in vals], dtype=object))
-    from .results import cf_finish
-
-    cf_finish(xr.Dataset(data), "phsplit sweep summary: one row per case", "sweep").to_netcdf(
-        os.path.join(store, "summary.nc"))
-    return path

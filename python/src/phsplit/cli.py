@@ -149,6 +149,20 @@ class UsageError(Exception):
     pass
 
 
+#: Seconds a run goes before its progress bar appears (a shorter run shows none).
+PROGRESS_DELAY = 2.0
+
+
+def _progress_bar(n: int):
+    """The progress bar of a run of ``n`` steps, on a terminal: shown once the run has taken
+    :data:`PROGRESS_DELAY` seconds, whatever its number of steps, and updated while the core
+    integrates (not only between chunks)."""
+    from tqdm import tqdm
+
+    return tqdm(total=n, unit="step", unit_scale=True, disable=not sys.stderr.isatty(), delay=PROGRESS_DELAY,
+                leave=False)
+
+
 def _chunks(n: int, save_every: int, target: int = 100, min_steps: int = 20_000) -> list[int]:
     """Split n steps into at most about `target` chunks of at least `min_steps` steps (so a short
     run is one call), each a multiple of save_every (but the last)."""
@@ -159,6 +173,13 @@ def _chunks(n: int, save_every: int, target: int = 100, min_steps: int = 20_000)
         out.append(min(size, n))
         n -= out[-1]
     return out
+
+
+def _vessel_stem(vessel: str) -> str:
+    """A --vessel's name for output names: a preset's name, a vessel file's stem."""
+    import re
+
+    return re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(vessel))[0]).lstrip("._-") or "vessel"
 
 
 def _override_suffix(args) -> str:
@@ -172,8 +193,8 @@ def _override_suffix(args) -> str:
         return s[:-2] if s.endswith(".0") else s
 
     parts = []
-    if getattr(args, "vessel", None):
-        parts.append(re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(args.vessel))[0]))
+    if getattr(args, "vessel", None) and getattr(args, "scenario", None):  # without one the name is the vessel's
+        parts.append(_vessel_stem(args.vessel))
     if args.method:
         parts.append(args.method.lower())
     if args.h is not None:
@@ -188,30 +209,6 @@ def _override_suffix(args) -> str:
         parts.append(f"c{args.control_start}")
     # Only the characters a scenario name may hold (the values were validated before this).
     return "".join("-" + re.sub(r"[^A-Za-z0-9._-]", "_", x) for x in parts)
-
-
-class _OutputLock:
-    """An exclusive lock on <out>/.<name>.lock for the whole run: two processes writing the same
-    output never interleave; the second is told so and stops before touching anything."""
-
-    def __init__(self, out: str, name: str):
-        import fcntl
-
-        path = os.path.join(out, f".{name}.lock")
-        try:
-            self.f = open(path, "a")
-        except OSError as e:
-            raise UsageError(f"cannot create {path!r}: {e.strerror}") from None
-        try:
-            fcntl.flock(self.f, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            self.f.close()
-            raise UsageError(f"another phsplit run is writing {os.path.join(out, name)}.nc right now; "
-                             "wait for it to finish, or choose another --out or scenario name") from None
-
-    def release(self) -> None:
-        if not self.f.closed:
-            self.f.close()  # closing drops the lock; the empty lock file stays (harmless, hidden)
 
 
 class _DeferSignals:
@@ -249,16 +246,27 @@ def _components(vessel) -> str:
 
 def _simulate(args) -> int:
     import phsplit
+    from . import cf
     from . import scenario as scn
-    from .plotting import plot_dp, publish
+    from .files import BusyError, PartialFile
+    from .plotting import plot_dp
 
-    sc = scn.load(args.scenario) if args.scenario else scn.Scenario.paper_fig2()
     if args.scenario:
+        # --vessel replaces the scenario's vessel; its environment, operation and overrides stay.
+        try:
+            sc = scn.load(args.scenario, vessel=args.vessel)
+        except (phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
+            if not args.vessel:
+                raise
+            raise type(e)(f"--vessel {args.vessel} with scenario {args.scenario}: {e}") from None
         args.scenario = sc.path  # a shipped scenario's file
-    if args.vessel:
-        import dataclasses
+    else:
+        sc = scn.Scenario.paper_fig2()
+        if args.vessel:
+            import dataclasses
 
-        sc = dataclasses.replace(sc, vessel=scn.vessel_named(args.vessel))
+            # The paper's Fig. 2 run with another vessel is named after that vessel, not "fig2".
+            sc = dataclasses.replace(sc, vessel=scn.vessel_named(args.vessel), name=_vessel_stem(args.vessel))
     over = {}
     if args.method:
         over["method"] = args.method
@@ -290,27 +298,35 @@ def _simulate(args) -> int:
         raise UsageError(f"output folder {out!r} is not writable")
     name = sc.name + _override_suffix(args)
     nc = os.path.join(out, f"{name}.nc")
-    lock = _OutputLock(out, name)  # a second run writing the same output is refused, not mixed in
+    try:
+        # The temporary file, locked: a second run writing the same output is refused, not mixed in.
+        partial = PartialFile(nc)
+    except BusyError:
+        raise UsageError(f"another phsplit run is writing {nc} right now; "
+                         "wait for it to finish, or choose another --out or scenario name") from None
+    except OSError as e:
+        raise UsageError(f"cannot create a file in {out!r}: {e.strerror}") from None
     t0, t1 = sc.t_span
     ctl = "never" if sc.control_start is None else f"t={sc.control_start:g} s"
-    print(f"phsplit {phsplit.__version__}: {sc.name}: {sc.method} h={sc.h:g} s on "
-          f"[{t0:g}, {t1:g}] s ({n} steps), controller from {ctl}; components: "
-          f"{_components(sc.vessel)}", flush=True)
-    if sc.environment:
-        print(f"environment: {scn.describe_environment(sc.environment)}", flush=True)
-    fd, part = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".nc.part")  # unique per run
-    os.close(fd)
+    try:
+        print(f"phsplit {phsplit.__version__}: {sc.name}: {sc.method} h={sc.h:g} s on "
+              f"[{t0:g}, {t1:g}] s ({n} steps), controller from {ctl}; components: "
+              f"{_components(sc.vessel)}", flush=True)
+        if sc.environment:
+            print(f"environment: {scn.describe_environment(sc.environment)}", flush=True)
+    except BaseException:
+        partial.discard()  # nothing was written yet
+        raise
+    part = partial.part
     t_start = time.perf_counter()
     done = 0
     status = "completed"
     sols = []
     nc_file = None
-    from tqdm import tqdm
+    from .chunks import run_chunks
+    from .settings import settings_to_toml
 
-    from .results import run_chunks
-    from .simulate import settings_to_toml
-
-    bar = tqdm(total=n, unit="step", unit_scale=True, disable=not (sys.stderr.isatty() and n > 20_000), leave=False)
+    bar = _progress_bar(n)
     try:
         chunks = _chunks(n, sc.save_every)
         text = None
@@ -323,14 +339,13 @@ def _simulate(args) -> int:
             "phsplit_scenario_path": args.scenario or "(built in: the paper's Fig. 2)",
             "phsplit_scenario": text if text is not None else "",
             "phsplit_environment": scn.describe_environment(sc.environment) if sc.environment else "calm water",
-            "history": f"{_now()} phsplit {phsplit.__version__}: phsplit {' '.join(args.argv)}",
+            "history": f"{cf.utc_now()} phsplit {phsplit.__version__}: phsplit {' '.join(args.argv)}",
         }
-        for sol in run_chunks(sc.vessel, sc.settings, sc.vessel.initial_state(), chunks):
+        for sol in run_chunks(sc.vessel, sc.settings, sc.vessel.initial_state(), chunks, progress=bar.update):
             with _DeferSignals():
                 nc_file = _append(nc_file, part, sol, first=(done == 0), attrs=file_attrs)
                 sols.append(sol)
                 done += sol.steps
-                bar.update(sol.steps)
             if sol.status == "interrupted":  # the core stopped on a signal and returned what it had
                 status = "interrupted"
                 break
@@ -349,10 +364,9 @@ def _simulate(args) -> int:
                 nc_file.setncattr("status", status)
                 nc_file.setncattr("steps", done)
                 nc_file.close()
-                publish(part, nc)
-            elif os.path.exists(part):
-                os.unlink(part)
-            lock.release()
+                partial.publish()
+            else:
+                partial.discard()
     dt = time.perf_counter() - t_start
     if status == "interrupted":
         if sols:
@@ -364,13 +378,15 @@ def _simulate(args) -> int:
     files = [nc]
     if not args.no_plot:
         png = os.path.join(out, f"{name}.png")
-        from .results import _joined
+        from .chunks import joined
 
-        plot_dp(_joined(sols), png)
+        plot_dp(joined(sols), png)
         files.append(png)
     e = last.euler[-1]
     rr = max(float(s_.ledger.relative_residual().max()) for s_ in sols)
-    print(f"{status}: {done} steps in {dt:.3f} s (integration and writing)")
+    total = _seconds_since_start()
+    print(f"{status}: {done} steps in {total:.2f} s in all (start-up, integration, writing, plotting); "
+          f"integration and writing {dt:.3f} s")
     print(f"t = {last.t[-1]:g} s: x = ({last.x[-1, 0]:.3f}, {last.x[-1, 1]:.3f}, {last.x[-1, 2]:.4f}) m, "
           f"roll/pitch/yaw = ({e[0]:.5f}, {e[1]:.5f}, {e[2]:.5f}) rad")
     print(f"energy H: {sols[0].energy[0]:.6e} -> {last.energy[-1]:.6e} J; worst relative ledger residual {rr:.2e}")
@@ -384,10 +400,19 @@ def _simulate(args) -> int:
     return 0
 
 
-def _now() -> str:
-    import datetime
+def _seconds_since_start() -> float:
+    """Wall-clock seconds since this process started (Linux: from /proc, so the interpreter's own
+    start-up counts too), else since phsplit was imported."""
+    import phsplit
 
-    return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    try:
+        with open("/proc/self/stat") as f:
+            after_name = f.read().rsplit(")", 1)[1].split()
+        with open("/proc/uptime") as f:
+            uptime = float(f.read().split()[0])
+        return max(0.0, uptime - int(after_name[19]) / os.sysconf("SC_CLK_TCK"))  # field 22: start time
+    except (OSError, ValueError, IndexError):  # pragma: no cover - systems without /proc
+        return time.perf_counter() - phsplit._STARTED
 
 
 def _append(nc_file, path: str, sol, first: bool, attrs: dict):
@@ -467,7 +492,7 @@ def _sweep(args) -> int:
 
 
 def _rerun(args) -> int:
-    from .plotting import publish
+    from .files import publish
     from .results import compare, open_dataset, rerun
 
     ds = open_dataset(args.file)
@@ -577,8 +602,12 @@ def _methods() -> int:
 def _vessels() -> int:
     import phsplit
 
+    from .vessel import PRESET_ALIASES
+
     for name, (desc, _) in phsplit.presets().items():
-        print(f"{name:8} {desc}")
+        print(f"{name:12} {desc}")
+    for old, new in PRESET_ALIASES.items():
+        print(f"{old:12} the earlier name of {new}, still accepted")
     print("use: phsplit simulate --vessel NAME, vessel = \"NAME\" in a scenario, or phsplit.Vessel.preset(NAME)")
     return 0
 

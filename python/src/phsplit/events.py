@@ -35,12 +35,15 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from . import _core
+from . import _core, _provided
+from .runner import continue_from, solution_of
+from .settings import Settings
+from .vessel import Vessel
 
 __all__ = ["Event", "EventHit", "watch_circle", "roll_beyond", "pitch_beyond", "energy_above"]
 
@@ -189,11 +192,7 @@ def _booked_steps(sol, names) -> np.ndarray:
 
 def _call(vessel, settings, t_a, t_b, h, y, save_every):
     """One core call of a run cut into several, continuing from the run's own state ``y``."""
-    from .simulate import simulate
-
-    h = min(h, t_b - t_a)  # a call of only a last, shorter step
-    return simulate(vessel, initial=y, settings=replace(settings, t_span=(t_a, t_b), h=h, save_every=save_every),
-                    _continuing=True)
+    return continue_from(vessel, settings, t_a, t_b, h, y, save_every)
 
 
 def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event] = ()):
@@ -324,8 +323,6 @@ def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, 
 
 def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
     """One Solution of the recorded rows; the ledger between rows from the cumulative booking."""
-    from .simulate import Ledger, Solution
-
     if not rows.rows:
         raise _core.InvalidInputError("nothing was computed: the run failed at its first step")
     src = rows.rows
@@ -339,16 +336,10 @@ def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
     zero = np.zeros(len(t))
     sup = zero + sum((by_account[nm] for nm in names if kinds[nm] == "supplied"), zero)
     dis = zero + sum((by_account[nm] for nm in names if kinds[nm] == "dissipated"), zero)
-    e = pick["energy"]
-    sol = Solution(
-        t=t, x=pick["x"], euler=pick["euler"], quaternion=pick["quaternion"], Q=pick["Q"], p=pick["p"], m=pick["m"],
-        mu=pick["mu"], phi_th=pick["phi_th"], phi_x=pick["phi_x"], energy=e,
-        ledger=Ledger(dH=np.concatenate([[0.0], np.diff(e)]), supplied=sup, dissipated=dis, by_account=by_account,
-                      kinds=dict(kinds), level=Ledger.level_of(e)),
-        orthogonality_defect=pick["orthogonality_defect"], status=status, method=tmpl.method, h=settings.h,
-        control_start=settings.control_start, steps=steps, failure=failure,
-        last_good_state=src[-1][0].state(src[-1][1]), meta=dict(tmpl.meta),
-        account_force=pick["account_force"], account_moment=pick["account_moment"],
+    sol = solution_of(
+        {"t": t, **pick}, booked, names, kinds, sup, dis,
+        status=status, method=tmpl.method, h=settings.h, control_start=settings.control_start, steps=steps,
+        failure=failure, last_good_state=src[-1][0].state(src[-1][1]), meta=dict(tmpl.meta),
         settings={**tmpl.settings, "t_span": tuple(settings.t_span), "h": settings.h,
                   "save_every": settings.save_every},
         outputs={k: (u, ln, np.array([s.outputs[k][2][i] for s, i, _ in src])) for k, (u, ln, _) in tmpl.outputs.items()},
@@ -357,3 +348,37 @@ def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
     sol.meta["events"] = hits
     sol.meta.pop("provenance", None)  # several core calls: not rerunnable as one
     return sol
+
+
+def dense_output(sol, times):
+    """``Solution.at``: the states at ``times`` within the run of ``sol``, each by stepping from
+    the last saved state at or before it (see ``Solution.at``)."""
+    prov = sol.meta.get("provenance")
+    if not prov or "vessel_toml" not in prov:
+        raise _core.InvalidInputError("this Solution does not record its vessel (it was assembled from several "
+                                      "runs); rerun with save_at instead")
+    ts = np.asarray(times, dtype=float).reshape(-1)
+    if ts.size == 0 or not np.all(np.isfinite(ts)) or ts.min() < sol.t[0] or ts.max() > sol.t[-1]:
+        raise _core.InvalidInputError(f"times must be finite and within the run [{sol.t[0]:g}, {sol.t[-1]:g}] s")
+    vessel = Vessel.from_toml_str(prov["vessel_toml"])
+    cs = sol.settings.get("control_start")
+    base = Settings(t_span=tuple(sol.settings["t_span"]), h=sol.h, method=sol.method, control_start=cs,
+                    outer=sol.settings["outer"], save_every=1, linear_flow=sol.settings["linear_flow"],
+                    ledger=bool(sol.settings["ledger"]),
+                    project_invariants=bool(sol.settings.get("project_invariants", True)))
+    names = list(sol.ledger.by_account)
+    rows = _Rows()
+    zero = np.zeros(len(names))
+    for t in ts:
+        i = int(np.searchsorted(sol.t, t, side="right")) - 1
+        if t - sol.t[i] <= 1e-12 * max(1.0, abs(t)):  # on a saved time, to round-off
+            p = _call(vessel, base, t, t + sol.h, sol.h, sol.state(i), 1)
+            rows.add(p, 0, zero, t=t)
+        else:
+            span = float(t) - float(sol.t[i])
+            p = _call(vessel, base, float(sol.t[i]), float(t), min(sol.h, span), sol.state(i), 1)
+            rows.add(p, -1, zero, t=t)
+    return _assemble(rows, names, "completed", None, [], 0, base)
+
+
+_provided.provide("dense_output", dense_output)

@@ -1,5 +1,5 @@
 """A phsplit vessel as an FMI 2.0 co-simulation FMU, for FMPy, OSP's libcosim and every FMI host
-(issue 15; docs/fmu.md).
+(docs/fmu.md).
 
 :func:`export` writes ``vessel.fmu``: ``modelDescription.xml``, the binary built from the Rust core
 (``binaries/linux64/phsplit_fmu.so``, no Python inside) and the vessel and settings as resources.

@@ -2,9 +2,10 @@
 from __future__ import annotations
 
 import os
-import tempfile
 
 import numpy as np
+
+from .files import publish, temporary_beside
 
 
 def plot_positions(sol, path: str, reference: dict | None = None, title: str | None = None) -> None:
@@ -24,7 +25,7 @@ def plot_positions(sol, path: str, reference: dict | None = None, title: str | N
         key = label.split(" ")[0]
         if key in ref:
             ax.axhline(ref[key], color="k", ls="--", lw=0.8, label=f"reference {ref[key]:g}")
-            ax.legend(loc="best", fontsize=8)
+            _legend_outside(ax, ncol=1)
         if sol.control_start is not None:
             ax.axvline(sol.control_start, color="0.6", ls=":", lw=0.8)
         ax.set_ylabel(label)
@@ -37,10 +38,8 @@ def plot_positions(sol, path: str, reference: dict | None = None, title: str | N
 
 
 def _save(fig, path: str) -> None:
-    d = os.path.dirname(os.path.abspath(path))
-    ext = os.path.splitext(path)[1]
-    fd, tmp = tempfile.mkstemp(dir=d, prefix=".tmp-", suffix=ext)
-    os.close(fd)
+    """Write the figure to ``path`` whole or not at all (a temporary file, then a rename)."""
+    tmp = temporary_beside(path)
     try:
         fig.savefig(tmp, dpi=110)
         publish(tmp, path)
@@ -48,15 +47,6 @@ def _save(fig, path: str) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-
-
-def publish(tmp: str, path: str) -> None:
-    """Move a finished temporary file into place atomically, with the usual permissions
-    (mkstemp creates files readable by their owner only)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    os.replace(tmp, path)
 
 
 def reference_of(vessel) -> dict:
@@ -79,7 +69,54 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
       touchdown points on the track, the offset from the desired position, and a fourth row with
       the pipe's top tension and departure angle and the thrusters' thrusts and utilisation.
 
-    A dotted line marks the start of the controller."""
+    A dotted line marks the start of the controller. Every legend is outside its axes' data
+    area, and curves that can coincide (roll and pitch, the thrusters, the ledger's accounts)
+    differ in line style as well as colour, the later ones drawn thinner over the earlier, so
+    none hides another."""
+    import matplotlib.pyplot as plt
+
+    fig = dp_figure(ds, watch_circle=watch_circle, title=title)
+    try:
+        _save(fig, path)
+    finally:
+        plt.close(fig)
+
+
+#: Line styles for curves that can coincide, in the order they are drawn: each a dash pattern
+#: that leaves the earlier, wider curves visible through its gaps.
+STYLES = ("-", (0, (5, 2)), (0, (1, 1.5)), (0, (6, 2, 1, 2)), (0, (3, 1, 1, 1, 1, 1)), (0, (8, 3)))
+
+
+#: Markers of the same curves, a few along each, at places that differ from curve to curve.
+MARKERS = ("o", "s", "^", "v", "D", "x", "P", "*")
+
+
+def _style(i: int, n: int | None = None) -> dict:
+    """The ``i``-th of several curves (``n`` samples) that may coincide: colour, dash pattern,
+    a width that decreases (a later curve on top of an earlier one leaves it visible) and, for a
+    curve of ``n`` samples, a few markers of its own shape, placed where the others have none."""
+    style = {"color": f"C{i % 10}", "ls": STYLES[i % len(STYLES)], "lw": max(0.8, 2.0 - 0.3 * i)}
+    if n is not None and n >= 16:
+        every = max(1, n // 8)
+        style.update(marker=MARKERS[i % len(MARKERS)], ms=4.5, markevery=((every // 2 + i * max(1, every // 6)) % every, every))
+    return style
+
+
+def _legend_outside(ax, ncol: int = 2, fontsize: float = 7.5, handles=None) -> None:
+    """A legend above the axes, outside its data area (constrained layout makes room)."""
+    if handles is None:
+        handles, labels = ax.get_legend_handles_labels()
+    else:
+        labels = [h.get_label() for h in handles]
+    if handles:
+        # as many columns as the axes' width holds at this size (about 80 characters)
+        ncol = max(1, min(ncol, len(handles), 80 // (max(len(s) for s in labels) + 8)))
+        ax.legend(handles, labels, loc="lower left", bbox_to_anchor=(0.0, 1.01, 1.0, 0.1), mode="expand",
+                  ncol=ncol, fontsize=fontsize, borderaxespad=0.0, frameon=False)
+
+
+def dp_figure(ds, watch_circle: float | None = None, title: str | None = None):
+    """The figure of :func:`plot_dp` (a matplotlib Figure; the caller closes it)."""
     import tomllib
 
     import matplotlib
@@ -123,17 +160,17 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     ax_track.set_ylabel("x [m]")
     ax_track.set_aspect("equal", adjustable="datalim")
     ax_track.set_title("horizontal track (spatial frame, z up)")
-    ax_track.legend(fontsize=8, loc="best")
+    ax_track.legend(fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.08), ncol=2, frameon=False)
     ax_track.grid(alpha=0.3)
 
     axes = [fig.add_subplot(gs[i, j]) for i in range(rows) for j in (1, 2)]
     ax_pos, ax_head, ax_rp, ax_heave, ax_ctl, ax_en = axes[:6]
     if moving:
-        ax_pos.plot(t, ds["setpoint_offset"].values, lw=1.2, label="distance")
+        ax_pos.plot(t, ds["setpoint_offset"].values, **_style(0, len(t)), label="distance")
         if "route_cross_track" in ds:
-            ax_pos.plot(t, ds["route_cross_track"].values, lw=1.0, label="across the route")
-            ax_pos.plot(t, ds["route_along_track"].values, lw=1.0, label="along the route")
-            ax_pos.legend(fontsize=8)
+            ax_pos.plot(t, ds["route_cross_track"].values, **_style(1, len(t)), label="across the route")
+            ax_pos.plot(t, ds["route_along_track"].values, **_style(2, len(t)), label="along the route")
+            _legend_outside(ax_pos, ncol=3)
         ax_pos.set_ylabel("offset from desired position [m]")
         err = eul[:, 2] - np.degrees(np.asarray(ds["setpoint_heading"].values))
         ax_head.plot(t, (err + 180.0) % 360.0 - 180.0, lw=1.2)
@@ -143,79 +180,86 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
         ax_pos.set_ylabel("distance to set point [m]")
         if watch_circle:
             ax_pos.axhline(watch_circle, color="r", ls="--", lw=1, label="watch circle")
-            ax_pos.legend(fontsize=8)
+            _legend_outside(ax_pos)
         ax_head.plot(t, (eul[:, 2] - ref_e[2] + 180.0) % 360.0 - 180.0, lw=1.2)
         ax_head.set_ylabel("heading error [deg]")
     else:
-        ax_pos.plot(t, x[:, 0], label="x")
-        ax_pos.plot(t, x[:, 1], label="y")
+        ax_pos.plot(t, x[:, 0], **_style(0, len(t)), label="x")
+        ax_pos.plot(t, x[:, 1], **_style(1, len(t)), label="y")
         ax_pos.set_ylabel("position [m]")
-        ax_pos.legend(fontsize=8)
+        _legend_outside(ax_pos)
         ax_head.plot(t, eul[:, 2], lw=1.2)
         ax_head.set_ylabel("yaw [deg]")
-    ax_rp.plot(t, eul[:, 0], lw=1.1, label="roll")
-    ax_rp.plot(t, eul[:, 1], lw=1.1, label="pitch")
+    # roll (usually the smaller) over pitch: neither hides the other
+    ax_rp.plot(t, eul[:, 1], **_style(1, len(t)), label="pitch", zorder=2)
+    ax_rp.plot(t, eul[:, 0], **_style(0, len(t)), label="roll", zorder=3)
     ax_rp.set_ylabel("roll, pitch [deg]")
-    ax_rp.legend(fontsize=8)
+    _legend_outside(ax_rp)
     ax_heave.plot(t, x[:, 2], lw=1.1)
     ax_heave.set_ylabel("heave z [m]")
     if "control_force" in ds:
         f = np.asarray(ds["control_force"].values) / 1e3
         mz = np.asarray(ds["control_moment"].values)[:, 2] / 1e6
-        ax_ctl.plot(t, f[:, 0], lw=1.1, label="surge force [kN]")
-        ax_ctl.plot(t, f[:, 1], lw=1.1, label="sway force [kN]")
+        ax_ctl.plot(t, f[:, 0], **_style(0, len(t)), label="surge force [kN]")
+        ax_ctl.plot(t, f[:, 1], **_style(1, len(t)), label="sway force [kN]")
         ax2 = ax_ctl.twinx()
-        ax2.plot(t, mz, "C3", lw=1.1, label="yaw moment [MN m]")
-        ax2.set_ylabel("yaw moment [MN m]", color="C3")
-        ax_ctl.legend(fontsize=8, loc="upper right")
+        ax2.plot(t, mz, **_style(2, len(t)), label="yaw moment [MN m] (right)")
+        ax2.set_ylabel("yaw moment [MN m]", color="C2")
+        _legend_outside(ax_ctl, ncol=3, handles=ax_ctl.get_lines() + ax2.get_lines())
     ax_ctl.set_ylabel("controller force [kN]")
-    ax_en.plot(t, np.asarray(ds["energy"].values) / 1e6, "k", lw=1.3, label="stored H")
+    ax_en.plot(t, np.asarray(ds["energy"].values) / 1e6, color="k", ls="-", lw=2.2, label="stored H")
+    k = 0
     for name in ds.data_vars:
         if name.startswith("energy_") and name not in ("energy_supplied", "energy_dissipated", "energy_residual"):
             kind = "dissipated" if "dissipated" in ds[name].attrs.get("long_name", "") else "supplied"
-            ax_en.plot(t, np.cumsum(np.nan_to_num(ds[name].values)) / 1e6, lw=1.0,
+            ax_en.plot(t, np.cumsum(np.nan_to_num(ds[name].values)) / 1e6, **_style(k, len(t)),
                        label=f"{name[7:]} ({kind}, cumulative)")
+            k += 1
     ax_en.set_ylabel("energy [MJ]")
-    ax_en.legend(fontsize=7)
+    _legend_outside(ax_en, ncol=2, fontsize=6.5)
     if rows == 4:
         ax_pipe, ax_thr = axes[6:8]
         if env and not piped:
             # the environment's horizontal force on the hull, by source (spatial frame)
             Q = np.asarray(ds["attitude"].values) if "attitude" in ds else None
-            for a in env:
+            for k, a in enumerate(env):
                 fb = np.asarray(ds[f"force_{a}"].values)
                 fs = np.einsum("nij,nj->ni", Q, fb) if Q is not None else fb
-                ax_pipe.plot(t, np.hypot(fs[:, 0], fs[:, 1]) / 1e3, lw=0.9, label=a)
+                ax_pipe.plot(t, np.hypot(fs[:, 0], fs[:, 1]) / 1e3, **_style(k, len(t)), label=a)
             ax_pipe.set_ylabel("horizontal force by source [kN]")
-            ax_pipe.legend(fontsize=7, loc="upper right")
+            _legend_outside(ax_pipe, ncol=len(env))
         elif piped:
-            ax_pipe.plot(t, ds["pipe_top_tension"].values / 1e3, lw=1.2, label="top tension [kN]")
-            ax_pipe.plot(t, ds["pipe_horizontal_tension"].values / 1e3, lw=1.0, label="horizontal tension [kN]")
+            ax_pipe.plot(t, ds["pipe_top_tension"].values / 1e3, **_style(0, len(t)), label="top tension [kN]")
+            ax_pipe.plot(t, ds["pipe_horizontal_tension"].values / 1e3, **_style(1, len(t)), label="horizontal tension [kN]")
             ax_pipe.set_ylabel("pipe tension [kN]")
-            ax_pipe.legend(fontsize=8, loc="center right")
             ax3 = ax_pipe.twinx()
-            ax3.plot(t, ds["pipe_departure_angle"].values, "C3", lw=1.0)
-            ax3.set_ylabel("departure angle [deg]", color="C3")
+            ax3.plot(t, ds["pipe_departure_angle"].values, **_style(2, len(t)), label="departure angle [deg] (right)")
+            ax3.set_ylabel("departure angle [deg]", color="C2")
+            _legend_outside(ax_pipe, ncol=3, handles=ax_pipe.get_lines() + ax3.get_lines())
         else:
             ax_pipe.set_axis_off()
         if thrust:
             i = 0
             while f"thruster{i}_thrust" in ds:
-                ax_thr.plot(t, ds[f"thruster{i}_thrust"].values / 1e3, lw=1.0, label=f"thruster {i} [kN]")
+                ax_thr.plot(t, ds[f"thruster{i}_thrust"].values / 1e3, **_style(i, len(t)), label=f"thruster {i} [kN]")
                 i += 1
             ax_thr.set_ylabel("thrust [kN]")
-            ax_thr.legend(fontsize=7, loc="upper right")
             ax4 = ax_thr.twinx()
-            ax4.plot(t, ds["thrust_utilisation"].values, "k:", lw=1.0)
+            ax4.plot(t, ds["thrust_utilisation"].values, color="k", ls=(0, (1, 2)), lw=1.0,
+                     label="utilisation (right)")
             ax4.set_ylabel("utilisation (dotted)")
             ax4.set_ylim(0, 1.05)
+            _legend_outside(ax_thr, ncol=3, handles=ax_thr.get_lines() + ax4.get_lines())
         elif env and "wave_elevation" in ds:
-            ax_thr.plot(t, ds["wave_elevation"].values, lw=0.7, color="C0", label="wave elevation [m]")
+            ax_thr.plot(t, ds["wave_elevation"].values, **_style(0, len(t)), label="wave elevation [m]")
             ax_thr.set_ylabel("wave elevation [m]")
+            handles = ax_thr.get_lines()
             if "wind_speed" in ds:
                 ax5 = ax_thr.twinx()
-                ax5.plot(t, ds["wind_speed"].values, lw=0.9, color="C3")
-                ax5.set_ylabel("wind speed [m/s]", color="C3")
+                ax5.plot(t, ds["wind_speed"].values, **_style(1, len(t)), label="wind speed [m/s] (right)")
+                ax5.set_ylabel("wind speed [m/s]", color="C1")
+                handles = handles + ax5.get_lines()
+            _legend_outside(ax_thr, handles=handles)
         else:
             ax_thr.set_axis_off()
     for ax in axes:
@@ -225,9 +269,8 @@ def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None 
     for ax in axes[-2:]:
         ax.set_xlabel("t [s]")
     if tc is not None and t[0] <= tc <= t[-1]:
-        ax_pos.annotate("controller on", (tc, 1.0), xycoords=("data", "axes fraction"), fontsize=8, color="0.4",
-                        xytext=(3, -10), textcoords="offset points")
+        ax_pos.annotate("controller on", (tc, 0.0), xycoords=("data", "axes fraction"), fontsize=8, color="0.4",
+                        xytext=(3, 3), textcoords="offset points")
     fig.suptitle(title or f"{ds.attrs.get('method', '').upper()}, h = {ds.attrs.get('step_size_s', '?')} s — "
                  f"{ds.attrs.get('status', '')}, t = {t[0]:g} … {t[-1]:g} s")
-    _save(fig, path)
-    plt.close(fig)
+    return fig

@@ -32,18 +32,18 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
-from .results import cf_finish
-from .simulate import StepSizeWarning, Vessel
-from .simulate import simulate as _simulate
+from . import _core, cf
+from .runner import StepSizeWarning
+from .simulate import simulate
+from .vessel import Vessel
 
 
-def simulate(*args, **kw):
+def simulate_as_printed(*args, **kw):
     """The paper's schemes as printed: without the projection onto the restoring invariant
     that phsplit applies by default (docs/model.md §3.6), so that the report measures the
     methods the paper describes, with its exact flow S2 (§3.4.2)."""
     kw.setdefault("linear_flow", "exact")
-    sol = _simulate(*args, project_invariants=False, **kw)
+    sol = simulate(*args, project_invariants=False, **kw)
     if sol.status == "interrupted":
         # Ctrl-C (or SIGTERM) while the core ran: it returned what it had. The study stops here,
         # as it would between runs, rather than going on with a cut run (a reference cut short
@@ -58,7 +58,7 @@ RK = ("euler", "heun", "rk4")
 
 
 @dataclass
-class Settings:
+class StudyPlan:
     quick: bool = False
 
     @property
@@ -99,7 +99,7 @@ class Claim:
 
 @dataclass
 class Results:
-    settings: Settings
+    settings: StudyPlan
     orders: dict[str, dict[str, float]] = field(default_factory=dict)
     order_errors: dict[str, dict[str, list[float]]] = field(default_factory=dict)
     order_hs: list[float] = field(default_factory=list)
@@ -156,7 +156,7 @@ def fit_order(hs: np.ndarray, errs: np.ndarray, order: int, floor: float) -> tup
 
 def _rk4_reference(vessel: Vessel, t_end: float, h: float, control_start: float | None, save_every: int):
     n = round(t_end / h)
-    return simulate(vessel, (0.0, n * h), h, "rk4", control_start=control_start, save_every=save_every,
+    return simulate_as_printed(vessel, (0.0, n * h), h, "rk4", control_start=control_start, save_every=save_every,
                     ledger=False)
 
 
@@ -180,7 +180,7 @@ def _control_torque_norm(vessel: Vessel, sol, on_from: float | None) -> np.ndarr
     return np.linalg.norm(sol.control_moment / T, axis=1)
 
 
-def run_order_test(vessel: Vessel, s: Settings, res: Results, bar) -> None:
+def run_order_test(vessel: Vessel, s: StudyPlan, res: Results, bar) -> None:
     yd = _dop853(vessel, 1.0, rtol=1e-13)[-1]
     yl = _dop853(vessel, 1.0, rtol=1e-12)[-1]
     rk = _rk4_reference(vessel, 1.0, s.h_ref_order, 0.0, save_every=10**9)
@@ -198,7 +198,7 @@ def run_order_test(vessel: Vessel, s: Settings, res: Results, bar) -> None:
     for meth in SPLITTING:
         errs: dict[str, list[float]] = {k: [] for k in ("m", "q", "p", "x")}
         for h in hs:
-            sol = simulate(vessel, (0.0, 1.0), h, meth, control_start=0.0, ledger=False)
+            sol = simulate_as_printed(vessel, (0.0, 1.0), h, meth, control_start=0.0, ledger=False)
             errs["m"].append(_rel(sol.m[-1], end["m"]))
             errs["q"].append(_rel(sol.quaternion[-1], end["q"]))
             errs["p"].append(_rel(sol.p[-1], end["p"]))
@@ -211,18 +211,18 @@ def run_order_test(vessel: Vessel, s: Settings, res: Results, bar) -> None:
         bar.update(1)
 
 
-def run_fig2(vessel: Vessel, s: Settings, res: Results, bar) -> None:
-    res.fig2 = simulate(vessel, (0.0, 200.0), 0.5, "sp4", control_start=50.0)
+def run_fig2(vessel: Vessel, s: StudyPlan, res: Results, bar) -> None:
+    res.fig2 = simulate_as_printed(vessel, (0.0, 200.0), 0.5, "sp4", control_start=50.0)
     r = _rk4_reference(vessel, 200.0, s.h_ref, 50.0, save_every=round(0.5 / s.h_ref))
     res.fig2_ref_diff = float(np.abs(res.fig2.x - r.x).max())
     bar.update(1)
 
 
-def run_fig4(vessel: Vessel, s: Settings, res: Results, bar) -> None:
+def run_fig4(vessel: Vessel, s: StudyPlan, res: Results, bar) -> None:
     for split, rk, h, t_end in (("sp2", "heun", 2.0 / 3.0, 50.0), ("sp4", "rk4", 1.9375, 100.0)):
         t_end = math.floor(t_end / h * (1 + 1e-12)) * h  # whole steps: the comparison grid is uniform
-        a = simulate(vessel, (0.0, t_end), h, split, control_start=0.0)
-        b = simulate(vessel, (0.0, t_end), h, rk, control_start=0.0)
+        a = simulate_as_printed(vessel, (0.0, t_end), h, split, control_start=0.0)
+        b = simulate_as_printed(vessel, (0.0, t_end), h, rk, control_start=0.0)
         n_sub = 8 * max(1, round(h / s.h_ref / 8))  # reference steps per method step, multiple of 8
         exact = _rk4_reference(vessel, a.t[-1], h / n_sub, 0.0, save_every=n_sub // 8)
         H0 = exact.energy[0]
@@ -244,12 +244,12 @@ def run_fig4(vessel: Vessel, s: Settings, res: Results, bar) -> None:
     res.fig4_ref_crosscheck = abs(vessel.energy(yd) - ex.energy[-1]) / ex.energy[0]
 
 
-def run_stability(vessel: Vessel, s: Settings, res: Results, bar) -> None:
+def run_stability(vessel: Vessel, s: StudyPlan, res: Results, bar) -> None:
     """Energy at the end of [0, 200] (Fig. 2 scenario) against h for every method. A run diverges
     when its state becomes non-finite or its energy exceeds 100x the largest energy of the
     converged SP2 run (the passivity bound: the energy cannot exceed what was stored plus what
     the controller supplied)."""
-    base = simulate(vessel, (0.0, 200.0), 0.25, "sp2", control_start=50.0)
+    base = simulate_as_printed(vessel, (0.0, 200.0), 0.25, "sp2", control_start=50.0)
     bound = 100.0 * float(base.energy.max())
     for meth in ALL_METHODS:
         res.stability[meth] = {}
@@ -257,7 +257,7 @@ def run_stability(vessel: Vessel, s: Settings, res: Results, bar) -> None:
         for h in s.stability_h:
             with warnings.catch_warnings():  # the sweep takes steps beyond the periods on purpose
                 warnings.simplefilter("ignore", StepSizeWarning)
-                sol = simulate(vessel, (0.0, 200.0), h, meth, control_start=50.0, ledger=False,
+                sol = simulate_as_printed(vessel, (0.0, 200.0), h, meth, control_start=50.0, ledger=False,
                                save_every=10**9)
             e_end = float(sol.energy[-1]) if sol.status == "completed" else math.inf
             e_max = float(np.max(sol.energy)) if sol.status == "completed" else math.inf
@@ -343,7 +343,7 @@ def figure3(res: Results, stage: str) -> list[str]:
         attrs={"experiment": "paper Fig. 3"},
     )
     p = os.path.join(stage, "fig3.nc")
-    cf_finish(ds, "phsplit reproduce: paper Fig. 3 (order test)", "reproduce").to_netcdf(p)
+    cf.finish(ds, "phsplit reproduce: paper Fig. 3 (order test)", "reproduce").to_netcdf(p)
     return paths + [p]
 
 
@@ -399,7 +399,7 @@ def figure4(res: Results, stage: str) -> list[str]:
     paths = _savefig(fig, stage, "fig4")
     plt.close(fig)
     p = os.path.join(stage, "fig4.nc")
-    cf_finish(xr.Dataset(data_vars, attrs={"experiment": "paper Fig. 4"}),
+    cf.finish(xr.Dataset(data_vars, attrs={"experiment": "paper Fig. 4"}),
               "phsplit reproduce: paper Fig. 4 (energy at long steps)", "reproduce").to_netcdf(p)
     return paths + [p]
 
@@ -437,7 +437,7 @@ def figure_stability(res: Results, stage: str) -> list[str]:
         attrs={"experiment": "stability sweep (paper §4, stated without a figure)"},
     )
     p = os.path.join(stage, "stability.nc")
-    cf_finish(ds, "phsplit reproduce: stability sweep", "reproduce").to_netcdf(p)
+    cf.finish(ds, "phsplit reproduce: stability sweep", "reproduce").to_netcdf(p)
     return paths + [p]
 
 
@@ -689,7 +689,7 @@ def reproduce(out: str, quick: bool = False, progress: bool = True, vessel: Vess
     from tqdm import tqdm
 
     vessel = vessel or Vessel.paper()
-    s = Settings(quick=quick)
+    s = StudyPlan(quick=quick)
     res = Results(settings=s)
     os.makedirs(out, exist_ok=True)
     if not os.access(out, os.W_OK | os.X_OK):

@@ -7,7 +7,7 @@ Zanna 2008); the attitude is a Magnus expansion of order 2, 4 or 6 in the right-
 (docs/numerics.md). Both ``|m|`` and the kinetic energy ``m . T^-1 m / 2`` are conserved, and so
 is the spatial momentum ``Q m``.
 
-Accuracy (issue 16; ``crates/phsplit-core/tests/rigid_body_reference.rs``): against mpmath (the
+Accuracy (``crates/phsplit-core/tests/rigid_body_reference.rs``): against mpmath (the
 closed form at 50 digits, checked against its ODE solver at 30) over random bodies,
 near-symmetric bodies (inertia gaps down to 1e-14), states next to the separatrix and next to the
 unstable middle axis, and ``t`` up to 1000, the momentum is within 4 times the problem's own

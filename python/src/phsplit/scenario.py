@@ -7,7 +7,19 @@ paper's exact S2 is ``linear_flow = "exact"``) and optionally a vessel: a path
 (``vessel = "osv"``; ``phsplit vessels``), or the paper's when absent.
 Any table of a vessel file given in the scenario (``[vessel]``, ``[control]``, ``[initial]``,
 ``[external]``, …) overrides that vessel key by key, so one gain or one load can be changed
-without copying the vessel file. Every key either acts or is refused: the core reads the
+without copying the vessel file. To change keys of the ``[vessel]`` table itself, name the base
+vessel inside it (TOML has no key that is both a string and a table)::
+
+    [vessel]
+    from = "osv"        # a shipped vessel or a vessel file
+    mass = 6.5e6        # kg: this key replaced, the others the preset's
+
+Directions (degrees, spatial frame, from x towards y) of the waves, the wind and the current:
+``direction`` or ``direction_towards`` where they go, ``direction_from`` where they come from.
+The current may be given by ``speed`` (m/s) and a direction instead of ``velocity``. The
+angles a vessel file takes in radians (``[initial] euler``, ``[control] euler_reference``,
+``[setpoint] headings``) may be given in degrees as ``euler_deg``, ``euler_reference_deg``,
+``headings_deg``. Every key either acts or is refused: the core reads the
 settings and the vessel, and names a key nobody reads, with the nearest valid one.
 
 .. code-block:: toml
@@ -43,12 +55,15 @@ import copy
 import difflib
 import math
 import os
+import re
 import tomllib
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from . import _core
-from .simulate import Settings, Vessel
+from . import hydro, sea
+from .settings import Settings
+from .vessel import PRESET_ALIASES, Vessel, presets
 
 
 @dataclass
@@ -106,12 +121,19 @@ def _read_toml(p: str, what: str) -> dict[str, Any]:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise _core.ScenarioParseError(f"{p}: TOML syntax error: {e}") from None
+        hint = ""
+        if re.search(r"^\s*vessel\s*=", text, re.M) and re.search(r"^\s*\[vessel\]", text, re.M):
+            hint = ("; to change keys of a shipped vessel or a vessel file, name it in the table instead: "
+                    "[vessel] from = \"osv\", then the keys to change")
+        raise _core.ScenarioParseError(f"{p}: TOML syntax error: {e}{hint}") from None
 
 
-def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...] = ()) -> Scenario:
+def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...] = (),
+              vessel: str | None = None) -> Scenario:
     """A scenario from its parsed tables; ``path`` names the file in messages and resolves a
-    relative vessel path."""
+    relative vessel path. ``vessel`` (a shipped vessel's name or a vessel file, relative to the
+    working folder) replaces the scenario's own vessel as the base its tables apply to: the
+    scenario's environment, operation (set point, pipe, thrusters) and overrides stay."""
     tables = set(_core.vessel_tables())
     top = {"simulation", "vessel", "environment"} | tables | set(allowed_extra)
     for k in data:
@@ -131,13 +153,33 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
                            for k in Settings.__dataclass_fields__})
     v = data.get("vessel")
     base_dir = os.path.dirname(os.path.abspath(path))
-    if v is None or isinstance(v, Mapping):
-        base, source = Vessel.paper(), "paper"
-    elif isinstance(v, str):
-        base, source = vessel_named(v, base_dir), v
-    else:
+    named = None
+    body: dict[str, Any] = {}
+    if isinstance(v, str):
+        named = v
+    elif isinstance(v, Mapping):
+        body = dict(v)
+        if "from" in body:
+            named = body.pop("from")
+            if not isinstance(named, str):
+                raise _core.ScenarioParseError(f"{path}: vessel.from must be a shipped vessel's name (phsplit vessels) "
+                                               f"or a vessel file's path, got {named!r}")
+    elif v is not None:
         raise _core.ScenarioParseError(f"{path}: 'vessel' must be a file path or a table, got {v!r}")
-    over = {k: val for k, val in data.items() if k in tables and not (k == "vessel" and isinstance(val, str))}
+    if vessel is not None:  # the command line's --vessel: the base the scenario's tables apply to
+        base, source = vessel_named(vessel), vessel
+    elif named is not None:
+        base, source = vessel_named(named, base_dir), named
+    else:
+        base, source = Vessel.paper(), "paper"
+    over = {k: val for k, val in data.items() if k in tables and k != "vessel"}
+    if body:
+        over["vessel"] = body
+    if isinstance(over.get("current"), Mapping):
+        over["current"] = current_table(dict(over["current"]), f"{path}: current")
+    for table, key in DEGREE_KEYS:
+        if isinstance(over.get(table), Mapping):
+            over[table] = in_radians(dict(over[table]), table, key, path)
     if "environment" in data:
         over = overlay(over, _environment(data["environment"], path, base_dir))
     if over:
@@ -158,6 +200,10 @@ def describe_environment(env: Mapping[str, Any]) -> str:
     parts = []
     cur = env.get("current")
     if isinstance(cur, Mapping):
+        try:
+            cur = current_table(dict(cur), "environment.current")
+        except _core.InvalidInputError:
+            pass
         if "velocity" in cur:
             v = [float(x) for x in cur["velocity"]]
             parts.append(f"current {math.hypot(v[0], v[1]):.2f} m/s towards "
@@ -168,12 +214,12 @@ def describe_environment(env: Mapping[str, Any]) -> str:
     if isinstance(w, Mapping):
         spread = f", spreading s = {w['spreading']:g}" if "spreading" in w else ", long-crested"
         parts.append(f"waves {w.get('spectrum', 'jonswap')} Hs {w['hs']:g} m Tp {w['tp']:g} s towards "
-                     f"{w.get('direction', 0.0):g} deg{spread}, {w.get('components', 200)} components, "
+                     f"{sea.direction_towards(w, 'environment.waves'):g} deg{spread}, {w.get('components', 200)} components, "
                      f"seed {w.get('seed', 0)}" + (f", transfer functions {w['hydro']}" if "hydro" in w else ""))
     wd = env.get("wind")
     if isinstance(wd, Mapping):
         spec = wd.get("spectrum", "npd")
-        parts.append(f"wind {wd['speed']:g} m/s towards {wd.get('direction', 0.0):g} deg, gusts {spec}"
+        parts.append(f"wind {wd['speed']:g} m/s towards {sea.direction_towards(wd, 'environment.wind'):g} deg, gusts {spec}"
                      + (f" (seed {wd.get('seed', 0)})" if spec not in (None, "none") else "")
                      + (f", {wd['ship_type']} coefficients" if "ship_type" in wd else ""))
     return "; ".join(parts)
@@ -207,8 +253,6 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
     into the ``[waves]`` component's components, with its transfer functions from a Capytaine
     dataset (``hydro = "file.nc"``, relative to the scenario; ``symmetric = true`` mirrors a
     port–starboard symmetric hull's directions) or from the vessel file's own ``[waves]`` keys."""
-    from . import hydro, sea
-
     if not isinstance(env, Mapping):
         raise _core.ScenarioParseError(f"{path}: [environment] must be a table")
     allowed = ("current", "waves", "wind")
@@ -222,7 +266,7 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
             raise _core.ScenarioParseError(f"{path}: [environment.{k}] must be a table")
     out: dict[str, Any] = {}
     if "current" in env:
-        out["current"] = dict(env["current"])
+        out["current"] = current_table(dict(env["current"]), f"{path}: environment.current")
     if "waves" in env:
         w = dict(env["waves"])
         try:
@@ -254,27 +298,74 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
     return out
 
 
+#: Angles the vessel file takes in radians that a scenario may give in degrees, as ``<key>_deg``.
+DEGREE_KEYS = (("initial", "euler"), ("control", "euler_reference"), ("setpoint", "headings"))
+
+
+def in_radians(table: dict[str, Any], name: str, key: str, path: str) -> dict[str, Any]:
+    """``table`` with ``<key>_deg`` (degrees: a number or a list of numbers) given as ``key``
+    (radians); both at once are refused."""
+    deg = f"{key}_deg"
+    if deg not in table:
+        return table
+    if key in table:
+        raise _core.InvalidInputError(f"{path}: give {name}.{key} (rad) or {name}.{deg} (degrees), not both")
+    v = table.pop(deg)
+    values = v if isinstance(v, list) else None
+    if values is None or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                                 for x in values):
+        raise _core.InvalidInputError(f"{path}: {name}.{deg} must be a list of finite numbers (degrees), got {v!r}")
+    table[key] = [math.radians(float(x)) for x in values]
+    return table
+
+
+def current_table(table: dict[str, Any], where: str) -> dict[str, Any]:
+    """A ``[current]`` table with the current given by ``speed`` (m/s) and a direction
+    (``direction``/``direction_towards``: where it goes, ``direction_from``: where it comes from;
+    degrees in the spatial frame, from x towards y) as the component reads it: a ``velocity``
+    vector. A table that gives ``velocity`` (or ``times``) is returned as it is."""
+    keys = ("speed",) + sea.DIRECTION_KEYS
+    if not any(k in table for k in keys):
+        return table
+    if "velocity" in table or "times" in table:
+        given = [k for k in keys if k in table]
+        raise _core.InvalidInputError(f"{where}: give the current either as velocity (or a table of times) or by "
+                                      f"speed and direction, not both (got {', '.join(given)} with "
+                                      f"{'velocity' if 'velocity' in table else 'times'})")
+    speed = table.get("speed")
+    if speed is None:
+        raise _core.InvalidInputError(f"{where}: a direction needs the current's speed (m/s): add speed = ...")
+    if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not math.isfinite(speed) or speed < 0:
+        raise _core.InvalidInputError(f"{where}.speed must be a number >= 0 (m/s), got {speed!r}")
+    if not any(k in table for k in sea.DIRECTION_KEYS):
+        raise _core.InvalidInputError(f"{where}: speed needs a direction (degrees): direction_towards = ... "
+                                      "(where the current goes) or direction_from = ... (where it comes from)")
+    towards = math.radians(sea.direction_towards(table, where))
+    out = {k: v for k, v in table.items() if k not in keys}
+    out["velocity"] = [float(speed) * math.cos(towards), float(speed) * math.sin(towards), 0.0]
+    return out
+
+
 def vessel_named(name: str, base_dir: str = ".") -> Vessel:
     """A vessel file (a path, relative to ``base_dir``) or, where no such file exists, a shipped
     vessel by name (``"osv"``; ``phsplit vessels`` lists them)."""
-    from .simulate import presets
-
     p = os.path.join(base_dir, name)
     if not os.path.exists(p) and os.sep not in name and not name.endswith(".toml"):
-        if name in presets():
+        if name in presets() or name in PRESET_ALIASES:
             return Vessel.preset(name)
         known = ", ".join(presets())
         raise _core.InvalidInputError(f"vessel {name!r} is neither a file nor a shipped vessel (shipped: {known})")
     return Vessel.from_toml(p)
 
 
-def load(path: str | os.PathLike[str]) -> Scenario:
-    """Read and validate a scenario file, or a shipped scenario by name (``"pipelay"``)."""
+def load(path: str | os.PathLike[str], vessel: str | None = None) -> Scenario:
+    """Read and validate a scenario file, or a shipped scenario by name (``"pipelay"``);
+    ``vessel`` replaces its vessel (see :func:`from_dict`)."""
     p = resolve(path)
     if not os.path.exists(p) and os.fspath(path) == p and os.sep not in p and not p.endswith(".toml"):
         names = ", ".join(shipped())
         raise _core.InvalidInputError(f"scenario {p!r} is neither a file nor a shipped scenario (shipped: {names})")
-    return from_dict(_read_toml(p, "scenario file"), p)
+    return from_dict(_read_toml(p, "scenario file"), p, vessel=vessel)
 
 
 def _name_of_file(path: str) -> str:

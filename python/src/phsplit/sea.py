@@ -33,6 +33,39 @@ def _number(v) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
+#: The keys that give a direction (degrees, spatial frame, from x towards y): ``direction`` and
+#: ``direction_towards`` the direction the waves, the wind or the current go towards (the
+#: oceanographic convention), ``direction_from`` the one they come from (the meteorological
+#: one: a wind from the north-east blows towards the south-west). One of them at most.
+DIRECTION_KEYS = ("direction", "direction_towards", "direction_from")
+
+
+def direction_towards(table, where: str, default: float = 0.0) -> float:
+    """The direction (degrees, towards) a table gives by one of :data:`DIRECTION_KEYS`, in
+    [0, 360) for ``direction_from``; ``default`` when it gives none. Two of them, or a value
+    that is not a finite number, raise :class:`phsplit.InvalidInputError` naming the key."""
+    given = [k for k in DIRECTION_KEYS if k in table]
+    if len(given) > 1:
+        raise _core.InvalidInputError(f"{where}: give one of {', '.join(given)}, not both (degrees; "
+                                      "direction and direction_towards: where it goes, direction_from: "
+                                      "where it comes from)")
+    if not given:
+        return default
+    k = given[0]
+    v = table[k]
+    if not _number(v):
+        raise _core.InvalidInputError(f"{where}.{k} must be a finite number (degrees), got {v!r}")
+    return (float(v) + 180.0) % 360.0 if k == "direction_from" else float(v)
+
+
+def _with_direction(table: dict, where: str) -> dict:
+    """``table`` with its direction key given as ``direction`` (towards)."""
+    out = {k: v for k, v in table.items() if k not in DIRECTION_KEYS}
+    if any(k in table for k in DIRECTION_KEYS):
+        out["direction"] = direction_towards(table, where)
+    return out
+
+
 def _check_range(where: str, r) -> None:
     ok = (isinstance(r, (tuple, list)) and len(r) == 2 and all(_number(x) for x in r) and 0 < r[0] < r[1])
     if not ok:
@@ -143,16 +176,19 @@ def regular(amplitude: float, omega: float, direction: float = 0.0, phase: float
 
 
 def sea_state(table: dict) -> SeaState:
-    """A :class:`SeaState` from a scenario's ``[environment.waves]`` keys (unknown keys named)."""
+    """A :class:`SeaState` from a scenario's ``[environment.waves]`` keys (unknown keys named;
+    the direction by ``direction``/``direction_towards`` or ``direction_from``, degrees)."""
     allowed = {"hs", "tp", "gamma", "spectrum", "direction", "spreading", "seed", "components", "omega_range"}
+    table = _with_direction(table, "environment.waves")
+    allowed_shown = allowed | set(DIRECTION_KEYS)
     unknown = sorted(set(table) - allowed - {"hydro", "symmetric"})
     if unknown:
         import difflib
 
-        near = difflib.get_close_matches(unknown[0], sorted(allowed), n=1)
+        near = difflib.get_close_matches(unknown[0], sorted(allowed_shown), n=1)
         hint = f"; did you mean {near[0]!r}?" if near else ""
         raise _core.ScenarioParseError(f"unknown field {unknown[0]!r} in [environment.waves]{hint} "
-                                       f"(allowed: {', '.join(sorted(allowed | {'hydro', 'symmetric'}))})")
+                                       f"(allowed: {', '.join(sorted(allowed_shown | {'hydro', 'symmetric'}))})")
     for k in ("hs", "tp"):
         if k not in table:
             raise _core.ScenarioParseError(f"missing field {k!r} in [environment.waves] "
@@ -265,16 +301,17 @@ def wind(table: dict) -> tuple[dict, dict]:
     """A scenario's ``[environment.wind]``: the realised wind keys, and the rest (the windage
     and coefficients), which go to the vessel's ``[wind]`` table unchanged."""
     own = {"speed", "direction", "spectrum", "seed", "components", "omega_range", "height", "drag"}
+    table = _with_direction(table, "environment.wind")
     windage = {"ship_type", "centroid_x", "frontal_area", "lateral_area", "length", "air_density", "angles", "cx",
                "cy", "cn"}
     unknown = sorted(set(table) - own - windage)
     if unknown:
         import difflib
 
-        near = difflib.get_close_matches(unknown[0], sorted(own | windage), n=1)
+        near = difflib.get_close_matches(unknown[0], sorted(own | windage | set(DIRECTION_KEYS)), n=1)
         hint = f"; did you mean {near[0]!r}?" if near else ""
         raise _core.ScenarioParseError(f"unknown field {unknown[0]!r} in [environment.wind]{hint} "
-                                       f"(allowed: {', '.join(sorted(own | windage))})")
+                                       f"(allowed: {', '.join(sorted(own | windage | set(DIRECTION_KEYS)))})")
     if "speed" not in table:
         raise _core.ScenarioParseError("missing field 'speed' in [environment.wind] (mean wind speed at 10 m, m/s)")
     kw = {k: table[k] for k in own if k in table}

@@ -11,7 +11,7 @@ Every function is vectorised: it takes a stack of vectors ``(..., 3)`` (or quate
 Gimbal lock: where ``cos(theta) <= GIMBAL_LOCK`` (4 eps) the pitch is ``+-pi/2`` to round-off and
 ``Q`` depends on ``psi -+ phi`` only; :func:`euler_zyx` then returns ``phi = 0`` (scipy's
 convention) and the yaw that rebuilds ``Q``. Next to it, the roll is read so that the angles
-rebuild ``Q`` to round-off at every pitch (issue 16).
+rebuild ``Q`` to round-off at every pitch.
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ order: :func:`ellipj`, :func:`ellipk`, :func:`ellipkm1`, :func:`ellipkinc`. The 
 ``numpy.asarray`` accepts), broadcasts them against each other, releases the GIL while it
 computes, and returns float64 arrays of the broadcast shape (numpy scalars for scalar inputs).
 
-Accuracy, against mpmath (issue 16; ``crates/phsplit-core/tests/elliptic_reference.rs``):
+Accuracy, against mpmath (``crates/phsplit-core/tests/elliptic_reference.rs``):
 
 * ``sn, cn, dn`` within 8 ulp, or within ``4 eps |u|`` absolute where the argument reduction
   limits it, for every ``m`` in ``[0, 1]`` and ``|u|`` up to ``1e15`` (the tables of Boost.Math

@@ -1,4 +1,4 @@
-//! Flow S1 of a rigid body in an ideal fluid with a general mass matrix (issue 18; docs/model.md
+//! Flow S1 of a rigid body in an ideal fluid with a general mass matrix (docs/model.md
 //! §3.8): Kirchhoff's equations on se(3)*, with the attitude on SO(3).
 //!
 //! With body-frame momenta `u = (p, m) = M ν`, `ν = (v, ω)`, `M = M_RB + M_A` symmetric positive
@@ -421,7 +421,7 @@ mod tests {
             u.fixed_rows::<3>(0).norm_squared(),
             u.fixed_rows::<3>(0).dot(&u.fixed_rows::<3>(3)),
         );
-        // Issue 18's measure: 10^5 steps of h = 1 s.
+        // The measure of the requirement: 10^5 steps of h = 1 s.
         for _ in 0..100_000 {
             (u, q) = k.flow(&u, &q, 1.0, 2).unwrap();
         }

@@ -132,7 +132,7 @@ impl FreeRigidBody {
         // den − num = |J_lo − J_hi| g, with the m_mid² terms cancelled in exact arithmetic:
         // g = 0 is the separatrix, and its sign picks the case. 1 − k² is formed from g, not as
         // 1 − num/den, which next to the separatrix (k² → 1) would keep only the digits of
-        // 1 − k² that survive the cancellation (issue 16: two of them at k² = 1 − 1.3e-14).
+        // 1 − k² that survive the cancellation (two of them at k² = 1 − 1.3e-14).
         let g = sq(hi) * d_mh - sq(lo) * d_lm;
         // (c, d, a, b, k², k'², |J_c − J_d|, |J_mid − J_d|)
         let (c, dd, a, b, k2, k1, d_cd, d_md) = if g >= 0.0 {
@@ -307,7 +307,7 @@ impl Jacobi {
         Self { s, c, d }
     }
 
-    /// The short path (issue 17): `(sn, cn, dn)(u | k²)` for `|u| ≤ 0.01` from their Maclaurin
+    /// The short path: `(sn, cn, dn)(u | k²)` for `|u| ≤ 0.01` from their Maclaurin
     /// series to `u⁷` (DLMF 22.10.1–3):
     /// `sn = u − (1+k²)u³/3! + (1+14k²+k⁴)u⁵/5! − (1+135k²+135k⁴+k⁶)u⁷/7!`,
     /// `cn = 1 − u²/2! + (1+4k²)u⁴/4! − (1+44k²+16k⁴)u⁶/6!`,
@@ -792,7 +792,7 @@ mod tests {
         }
     }
 
-    /// Issue 16, item 2: next to the middle (unstable) axis, k² = 1 − 1.3e-14, and 1 − k² formed
+    /// Next to the middle (unstable) axis, k² = 1 − 1.3e-14, and 1 − k² formed
     /// as `1 − num/den` kept two of its digits (the third component was off by 2.3e-11 of |m|
     /// at t = 0.5 and 1.9e-5 at t = 50); the start phase read through `φ₀ = atan2(sn, cn)` then
     /// cost 5e-12 more, F's slope being 1/dn ν ≈ 4e6 there. References: mpmath's ODE solver at

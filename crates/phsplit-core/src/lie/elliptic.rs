@@ -28,7 +28,7 @@
 //! separatrix): [`jacobi_m1`], [`ellipk_m1`] and [`ellipf_m1`] take it as an argument, and
 //! [`ellipf_scd`] takes the amplitude as its sine, cosine and `Δ` rather than as an angle.
 //!
-//! Accuracy against mpmath (issue 16): `tests/elliptic_reference.rs` (Boost.Math's table inputs
+//! Accuracy against mpmath: `tests/elliptic_reference.rs` (Boost.Math's table inputs
 //! and an adversarial grid up to `|u| = 10¹⁵`) and `tests/elliptic_mpmath.rs`, on the tables
 //! written by `scripts/gen_elliptic_refs.py`.
 
@@ -599,7 +599,7 @@ mod tests {
         assert!(ellipf(1.0, 2.0).is_err() && ellipf(0.5, 2.0).is_ok());
     }
 
-    /// Issue 16, item 1: next to m = 1 (the ascending-Landen branch, m₁ < 1e-3), large |u|
+    /// Next to m = 1 (the ascending-Landen branch, m₁ < 1e-3), large |u|
     /// overflowed cosh (NaN from |u| ≈ 711) and lost digits from |u| ≈ 375, because nothing
     /// reduced the argument by the period. Values from mpmath (50 digits).
     #[test]
@@ -643,7 +643,7 @@ mod tests {
         for (u, m, want) in cases {
             let got = jacobi(u, m);
             for (g, w) in [got.0, got.1, got.2].iter().zip(want) {
-                // 8 ulp, or 4 eps |u| where the reduction limits it (issue 16 bounds)
+                // 8 ulp, or 4 eps |u| where the reduction limits it (the documented bounds)
                 assert!(
                     (g - w).abs() <= (8.0 * eps * w.abs()).max(4.0 * eps * u.abs()),
                     "({u}, {m}): {got:?} vs {want:?}"

@@ -362,7 +362,7 @@ mod tests {
         }
     }
 
-    /// Issue 16, item 3: at gimbal lock the entries Q11, Q21, Q32, Q33 are round-off, and
+    /// At gimbal lock the entries Q11, Q21, Q32, Q33 are round-off, and
     /// reading roll and yaw from them gave (0, 1.5708, −0.98279), which rebuilds a matrix 0.385
     /// away. The matrix is scipy's `Rotation.from_euler("ZYX", [−1.1, fl(π/2), 0.3])`, entry
     /// for entry (its round-off included); scipy returns (0, π/2, −1.4) for it.

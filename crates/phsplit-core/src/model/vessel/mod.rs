@@ -44,11 +44,15 @@ pub const PRESETS: &[(&str, &str, &str)] = &[
         include_str!("../../../data/vessels/osv.toml"),
     ),
     (
-        "supply",
-        "82.8 m supply vessel of MSS's ShipX data, the paper's vessel with its added mass, CG 5.4 m aft, full damping and restoring",
+        "shipx-supply",
+        "82.8 m supply vessel of MSS's ShipX data (not MSS's supply.m, a 76.2 m vessel), the paper's vessel with its added mass, CG 5.4 m aft, full damping and restoring",
         include_str!("../../../data/vessels/supply.toml"),
     ),
 ];
+
+/// Earlier names of shipped vessels: (old name, preset it stands for). `supply` was renamed
+/// `shipx-supply`: MSS's own `supply.m` is a different, 76.2 m vessel.
+pub const PRESET_ALIASES: &[(&str, &str)] = &[("supply", "shipx-supply")];
 
 /// The default initial state, in engineering variables (table `[initial]`).
 #[derive(Debug, Clone, PartialEq)]
@@ -175,6 +179,10 @@ impl Vessel {
 
     /// A shipped vessel by name ([`PRESETS`]).
     pub fn preset(name: &str) -> Result<Self> {
+        let name = PRESET_ALIASES
+            .iter()
+            .find(|a| a.0 == name)
+            .map_or(name, |a| a.1);
         match PRESETS.iter().find(|p| p.0 == name) {
             Some((_, _, text)) => Self::from_toml_str(text),
             None => Err(crate::error::Error::InvalidInput(format!(

@@ -1,5 +1,5 @@
-//! Cross-flow drag: the nonlinear sway and yaw damping of a hull by strip theory (issue 18;
-//! docs/model.md §5.12). T. I. Fossen, *Handbook of Marine Craft Hydrodynamics and Motion
+//! Cross-flow drag: the nonlinear sway and yaw damping of a hull by strip theory
+//! (docs/model.md §5.12). T. I. Fossen, *Handbook of Marine Craft Hydrodynamics and Motion
 //! Control*, 2nd ed., Wiley 2021, §6.4.3 (after Faltinsen 1990):
 //!
 //! ```text

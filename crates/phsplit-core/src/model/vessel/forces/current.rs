@@ -1,4 +1,4 @@
-//! A constant, uniform ocean current (issue 11, its first part; docs/model.md §5.5).
+//! A constant, uniform ocean current (docs/model.md §5.5).
 //!
 //! Table `[current]` (optional): `velocity` (m/s, spatial frame, z up; the direction the water
 //! flows towards), each component within ±10 m/s. The hydrodynamic damping then acts on the

@@ -1,7 +1,7 @@
 //! Quadratic (nonlinear) hydrodynamic damping: the diagonal part of Fossen's `D_n(ν)ν`
 //! (T. I. Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*, 2nd ed., Wiley
 //! 2021, §6.4: `D_n(ν) = −diag(X_|u|u |u|, Y_|v|v |v|, Z_|w|w |w|, K_|p|p |p|, M_|q|q |q|,
-//! N_|r|r |r|)`), issue 18, docs/model.md §5.11.
+//! N_|r|r |r|)`), docs/model.md §5.11.
 //!
 //! Table `[damping_quadratic]` (optional): `coefficients`, six numbers ≥ 0 (surge, sway, heave in
 //! kg/m; roll, pitch, yaw in kg m²), Fossen's `−X_|u|u, …` (his derivatives are ≤ 0). The force

@@ -1,6 +1,7 @@
-//! The three failures of issue 16 ("exact means exact at the edges"), at the inputs the issue
-//! gives and around them, through the public API only (so that they run unchanged against the
-//! code before the fix, where each of them fails).
+//! Exact at the edges of the domain: Jacobi's elliptic functions at large arguments next to
+//! m = 1, the free rigid body's momentum next to the middle (unstable) axis, and the Euler
+//! angles at gimbal lock, at the inputs where each once failed and around them, through the
+//! public API only.
 //!
 //! References: mpmath (50 digits for the elliptic functions; its ODE solver at 30 digits for the
 //! rigid body, agreeing with the closed form at 50 digits to 1e-31), and scipy's answer at gimbal
@@ -12,7 +13,7 @@ use phsplit_core::lie::so3::{euler_zyx, from_euler_zyx};
 
 const EPS: f64 = f64::EPSILON;
 
-/// Item 1: sn, cn, dn for large |u| next to m = 1 (the branch used when 1 − m < 1e-3).
+/// sn, cn, dn for large |u| next to m = 1 (the branch used when 1 − m < 1e-3).
 #[test]
 fn jacobi_functions_at_large_arguments_next_to_m_equal_one() {
     // (u, m, mpmath's (sn, cn, dn))
@@ -57,7 +58,7 @@ fn jacobi_functions_at_large_arguments_next_to_m_equal_one() {
     for (u, m, want) in cases {
         let (s, c, d) = jacobi(u, m);
         for (g, w) in [s, c, d].into_iter().zip(want) {
-            // the issue's bound: 8 ulp, or 4 ε |u| where the argument reduction limits it
+            // the bound: 8 ulp, or 4 ε |u| where the argument reduction limits it
             assert!(
                 (g - w).abs() <= (8.0 * EPS * w.abs()).max(4.0 * EPS * u.abs()),
                 "({u}, {m}): ({s}, {c}, {d}) vs {want:?}"
@@ -84,7 +85,7 @@ fn jacobi_functions_at_large_arguments_next_to_m_equal_one() {
     }
 }
 
-/// Item 2: the exact momentum orbit next to the middle (unstable) axis: I = (1, 2, 3),
+/// The exact momentum orbit next to the middle (unstable) axis: I = (1, 2, 3),
 /// m0 = (1e-7, 1, 2e-7), k² = 0.9999999999999867. The error was 2.3e-11 |m| at t = 0.5,
 /// 4.5e-11 at t = 5 and 1.9e-5 at t = 50, while one ulp in any input moves the solution by
 /// 2.2e-16 |m| (t = 0.5, 5) and 2.4e-16 |m| (t = 50).
@@ -139,7 +140,7 @@ fn momentum_next_to_the_middle_axis_is_as_accurate_as_the_problem_allows() {
     );
 }
 
-/// Item 3: Euler angles at gimbal lock: euler_zyx of the matrix scipy builds for
+/// Euler angles at gimbal lock: euler_zyx of the matrix scipy builds for
 /// from_euler_zyx(0.3, fl(π/2), −1.1) returned (0, 1.5708, −0.98279), 0.385 away when rebuilt.
 #[test]
 fn euler_angles_at_gimbal_lock_rebuild_the_matrix() {

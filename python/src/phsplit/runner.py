@@ -1,0 +1,133 @@
+"""One core call: :func:`run` integrates a vessel with given settings from a given state and
+builds its :class:`~phsplit.solution.Solution` (:func:`solution_of`, the one place a Solution
+is made, used by the multi-call drivers too), with the warnings on the step size and on
+energy created by negative sub-steps."""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from . import _core
+from .settings import Settings
+from .solution import Ledger, Solution
+from .vessel import Vessel
+
+class StepSizeWarning(UserWarning):
+    """The step is longer than half the vessel's shortest natural period: the run stays
+    passive and bounded (for the splitting methods) but cannot resolve that motion."""
+
+
+class PassivityWarning(UserWarning):
+    """A composition with negative sub-steps created energy: its discrete map is passive only
+    under the condition of the paper's Prop. 2.5, which this run does not meet."""
+
+def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray, stacklevel: int) -> None:
+    """Prop. 2.5: with negative sub-steps the composition dissipates only if
+    sum(mu_i c_i) >= 0 over the dissipative flow's coefficients, i.e. if sigma_max/sigma_min of
+    H^(1/2) D H^(1/2) is below a bound of the method. Here D acts on the velocities only
+    (sigma_min = 0), so the condition never holds; the ledger tells whether energy was created."""
+    d = raw["dissipated"][1:]
+    scale = abs(e[0]) + np.abs(raw["supplied"]).sum() + np.abs(d[np.isfinite(d)]).sum()
+    bad = ~np.isfinite(d) | (d < -1e-12 * scale)
+    if not bad.any():
+        return
+    i = int(np.argmax(bad)) + 1
+    key = "dissipation_ratio_bound_outer" if outer == "dissipative" else "dissipation_ratio_bound_inner"
+    warnings.warn(PassivityWarning(
+        f"{info['name'].upper()} has negative sub-steps and created energy in {int(bad.sum())} saved "
+        f"interval(s), first ending at t = {raw['t'][i]:g} s ({d[i - 1]:.3e} J dissipated). Its passivity needs "
+        f"the Prop. 2.5 condition sigma_max/sigma_min <= {info[key]:.3g} for H^(1/2) D H^(1/2); this vessel's "
+        "D is only semidefinite (sigma_min = 0), so the condition does not hold. Use a smaller h, or "
+        "'sp2'/'lie', whose positive steps are passive for any h (Prop. 2.2)."), stacklevel=stacklevel)
+
+
+def _warn_if_step_too_long(vessel: Vessel, y0: np.ndarray | None, settings: Settings, stacklevel: int) -> None:
+    """A StepSizeWarning when h exceeds half the shortest natural period of the
+    vessel (flow S2 linearised at the initial attitude, with the controller as it will act):
+    fewer than two steps per period cannot represent that oscillation."""
+    try:
+        h = float(settings.h)
+        if not (math.isfinite(h) and h > 0.0):
+            return  # the core refuses it, by name, when the run starts
+        state = vessel.initial_state() if y0 is None else y0
+        periods = vessel._natural_periods_at(state, settings.control_start is not None)
+    except (_core.InvalidInputError, ValueError, TypeError):
+        return  # the core reports bad input when the run starts
+    if periods and h > 0.5 * periods[0]:
+        warnings.warn(StepSizeWarning(
+            f"h = {h:g} s is more than half the vessel's shortest natural period ({periods[0]:.3g} s; "
+            f"periods {', '.join(f'{p:.3g}' for p in periods[:4])} s): the run cannot resolve that motion. "
+            f"The splitting methods stay bounded and passive at such steps; take h < {0.5 * periods[0]:.3g} s to "
+            f"resolve it, and about a tenth of the period ({0.1 * periods[0]:.2g} s) to follow it accurately."),
+            stacklevel=stacklevel)
+
+
+
+def solution_of(columns: dict[str, np.ndarray], booked: np.ndarray, names: list[str], kinds: dict[str, str],
+                supplied: np.ndarray, dissipated: np.ndarray, **rest) -> Solution:
+    """The one constructor of a :class:`Solution`: the state ``columns`` at the saved times
+    (``t``, ``x``, ``euler``, ``quaternion``, ``Q``, ``p``, ``m``, ``mu``, ``phi_th``,
+    ``phi_x``, ``energy``, ``orthogonality_defect``, ``account_force``, ``account_moment``),
+    the energy ``booked`` by each account in each saved interval ((N, accounts), first row
+    zero) with their ``kinds``, their totals ``supplied`` and ``dissipated``, and the run's
+    other fields (``status``, ``method``, ``h``, ...). The ledger's ``dH`` and levels come from
+    the energy here, the same way for a single call and for a run assembled from several."""
+    e = np.asarray(columns["energy"])
+    ledger = Ledger(dH=np.concatenate([[0.0], np.diff(e)]) if len(e) else e, supplied=supplied,
+                    dissipated=dissipated, by_account={n: booked[:, k] for k, n in enumerate(names)},
+                    kinds=dict(kinds), level=Ledger.level_of(e))
+    return Solution(ledger=ledger, **columns, **rest)
+
+
+_COLUMNS = ("t", "x", "euler", "quaternion", "Q", "p", "m", "mu", "phi_th", "phi_x", "energy",
+            "orthogonality_defect", "account_force", "account_moment")
+
+
+def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, orthonormalize: bool = False,
+        callback=None, running_max: bool = False, continuing: bool = False, stacklevel: int = 4) -> Solution:
+    """One core call: ``vessel`` integrated with ``settings`` from ``y0`` (the vessel's initial
+    state when None). ``continuing``: ``y0`` is the last state of an earlier call of the same
+    run (chunks, ``save_at``, events, ``Solution.at``), taken as it is, only checked to be finite.
+    ``callback(steps_done, n_steps)`` is called as the core goes. ``stacklevel`` places the
+    warnings at the user's call."""
+    _warn_if_step_too_long(vessel, y0, settings, stacklevel)
+    raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), callback, bool(running_max),
+                          bool(continuing and y0 is not None))
+    used = raw["settings"]
+    e = raw["energy"]
+    info = _core.method_info(used["method"])
+    if used["ledger"] and info["kind"] == "splitting" and not info["all_positive"] and len(e) > 1:
+        _warn_if_energy_created(raw, info, used["outer"], e, stacklevel)
+    mass, inertia = vessel._body()
+    names = list(raw["accounts"])
+    sol = solution_of(
+        {k: raw[k] for k in _COLUMNS}, raw["booked"], names, dict(zip(names, raw["account_kinds"])),
+        raw["supplied"], raw["dissipated"],
+        status=raw["status"], method=info["name"], h=used["h"], control_start=used["control_start"],
+        steps=raw["steps"], failure=raw.get("failure"), last_good_state=raw["last_good"],
+        meta={"mass": mass, "inertia": inertia, "mass_matrix": vessel.mass_matrix,
+              "t_last_good": raw["t_last_good"], "components": vessel.components},
+        settings=dict(used),
+        outputs={k: (u, ln, np.asarray(v)) for k, (u, ln, v) in raw.get("outputs", {}).items()},
+        actuators=raw.get("actuators"),
+    )
+    # What reruns it (phsplit rerun): the vessel file, the initial state the core used, one chunk.
+    sol.meta["running_max"] = dict(raw["running_max"])
+    sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0),
+                              "chunks": [int(used["n_steps"])]}
+    return sol
+
+
+def continue_from(vessel: Vessel, settings: Settings, t_a: float, t_b: float, h: float, y: np.ndarray,
+                  save_every: int, callback=None) -> Solution:
+    """One core call of a run cut into several: ``settings`` on ``[t_a, t_b]`` with step ``h``
+    (a call of only a last, shorter step takes that step's length), continuing from the run's
+    own state ``y``."""
+    from dataclasses import replace
+
+    h = min(h, t_b - t_a)
+    y = np.ascontiguousarray(y, dtype=float)
+    return run(vessel, replace(settings, t_span=(t_a, t_b), h=h, save_every=save_every), y, callback=callback,
+               continuing=True, stacklevel=5)
