@@ -50,3 +50,31 @@ def test_the_readme_stays_short_and_shows_the_two_commands():
     assert len(text.encode("utf-8")) <= 8192
     assert "make run" in text and "make test" in text
     assert "docs/figures/fig2.png" in text
+
+
+DOCS = README.parent / "docs"
+
+
+def test_every_python_example_of_the_docs_runs_in_their_build():
+    """A ```python block of a page is either executed by `make docs` (markdown-exec's
+    exec="on") or it is not an example; none is left to rot unexecuted."""
+    idle = []
+    for page in sorted(DOCS.rglob("*.md")):
+        for m in re.finditer(r"^```python(.*)$", page.read_text(encoding="utf-8"), re.M):
+            if 'exec="on"' not in m.group(1):
+                idle.append(f"{page.relative_to(DOCS)}: ```python{m.group(1)}")
+    assert not idle, "Python examples the docs build does not run:\n" + "\n".join(idle)
+
+
+def test_docs_model_md_lists_every_numbered_section_where_it_is():
+    """The code cites the model as `docs/model.md §N.M`: docs/model.md must list each numbered
+    section of the explanation pages with a link to its page and anchor, and nothing else."""
+    index = (DOCS / "model.md").read_text(encoding="utf-8")
+    listed = set(re.findall(r"\]\((explanation/[^)#]+)#(sec-[\d-]+)\)", index))
+    present = set()
+    for page in (DOCS / "explanation").rglob("*.md"):
+        rel = page.relative_to(DOCS).as_posix()
+        for anchor in re.findall(r"^#+ \d+(?:\.\d+)?\.? .*\{ #(sec-[\d-]+) \}$", page.read_text(encoding="utf-8"), re.M):
+            present.add((rel, anchor))
+    assert present, "no numbered sections found"
+    assert listed == present, (sorted(present - listed), sorted(listed - present))
