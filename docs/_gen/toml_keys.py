@@ -5,7 +5,9 @@ Which keys exist is asked of the code itself: the core's settings table
 allowed keys that the parser prints when it meets an unknown one. Units, defaults and meanings
 are written below from the modules that read each table (their module docs, named in SOURCE).
 The build fails when the two disagree: a key the code accepts and this file does not describe,
-or a key described here that the code no longer accepts.
+a key described here that the code no longer accepts, a key documented as required that may be
+left out (or the reverse), or a literal default that is not what the parser fills in. Units and
+meanings are not checked: they drift only with the modules they were written from.
 """
 from __future__ import annotations
 
@@ -37,8 +39,8 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "flotation_center_y": ("m", "0", "centre of flotation, body y; couples heave and roll (§5.15)"),
     },
     "initial": {
-        "euler": ("rad", "[0, 0, 0]", "ZYX Euler angles (roll, pitch, yaw), eq. (21)"),
-        "position": ("m", "[0, 0, 0]", "position of the body origin, spatial frame, z up"),
+        "euler": ("rad", REQ, "ZYX Euler angles (roll, pitch, yaw), eq. (21)"),
+        "position": ("m", REQ, "position of the body origin, spatial frame, z up"),
         "velocity": ("m/s", "[0, 0, 0]", "linear velocity, body frame"),
         "angular_velocity": ("rad/s", "[0, 0, 0]", "angular velocity, body frame"),
     },
@@ -59,7 +61,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "frame": ("-", '"body"', '`"body"` or `"spatial"`: the frame of `force` and `moment`'),
     },
     "current": {
-        "velocity": ("m/s", "none", "uniform current, spatial frame, towards; each component within ±10 m/s (§5.5)"),
+        "velocity": ("m/s", "[0, 0, 0]", "uniform current, spatial frame, towards; each component within ±10 m/s (§5.5)"),
         "times": ("s", "none", "instead of `velocity`: increasing times of a current table"),
         "velocities": ("m/s", "none", "one row of 3 numbers per time; linear in between, constant outside"),
     },
@@ -124,9 +126,9 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
     "wind": {
         "speed": ("m/s", REQ, "mean wind speed, ≥ 0, ≤ 80 (§5.10)"),
         "direction": ("degrees", REQ, "the direction the wind blows towards, spatial"),
-        "gust_frequencies": ("rad/s", "none", "gust components (realised by `phsplit.sea.Wind`), > 0"),
-        "gust_amplitudes": ("m/s", "none", "≥ 0"),
-        "gust_phases": ("rad", "none", "one per gust component"),
+        "gust_frequencies": ("rad/s", "together: all three or none", "gust components (realised by `phsplit.sea.Wind`), > 0"),
+        "gust_amplitudes": ("m/s", "together: all three or none", "≥ 0"),
+        "gust_phases": ("rad", "together: all three or none", "one per gust component"),
         "frontal_area": ("m²", REQ, "frontal projected area `A_F`, > 0"),
         "lateral_area": ("m²", REQ, "lateral projected area `A_L`, > 0"),
         "length": ("m", REQ, "length `L` for the yaw moment, > 0"),
@@ -246,9 +248,56 @@ def accepted() -> dict[str, set[str]]:
     return out
 
 
+def _examples() -> dict[str, dict]:
+    """A valid vessel file (as tables) that has each vessel table."""
+    paper = phsplit.Vessel.paper().to_dict()
+    pipelay = scenario.load("pipelay").vessel.to_dict()
+    weather = scenario.load("dp-weather").vessel.to_dict()
+    return {"vessel": paper, "initial": paper, "control": paper, "external": {**paper, "external": {"force": [1.0, 0.0, 0.0]}},
+            "current": weather, "pipe": pipelay, "setpoint": pipelay, "thrusters": pipelay, "waves": weather,
+            "wind": weather, "crossflow_drag": phsplit.Vessel.preset("osv").to_dict(),
+            "damping_quadratic": {**paper, "damping_quadratic": {"coefficients": [1.0] * 6}}}
+
+
+def _literal(text: str):
+    """The value a documented default stands for, when it is one literal (else None)."""
+    import tomllib
+
+    try:
+        return tomllib.loads(f"x = {text}")["x"]
+    except tomllib.TOMLDecodeError:
+        return None
+
+
+def check_defaults() -> list[str]:
+    """Each documented default of a vessel table against the parser: a key documented as
+    required must be refused when absent, and a literal default must be what the parser fills
+    in when the key is left out (where it reports the value back)."""
+    problems = []
+    for table, d in _examples().items():
+        for key in list(d[table]):
+            unit, default, _ = KEYS[table][key]
+            e = copy.deepcopy(d)
+            del e[table][key]
+            try:
+                filled = phsplit.Vessel.from_dict(e).to_dict()[table].get(key)
+            except (_core.InvalidInputError, _core.ScenarioParseError):
+                if default == REQ:
+                    continue
+                if not default.startswith(("required", "one of", "together")):
+                    problems.append(f"{table}.{key} is documented with the default {default!r} but is required")
+                continue
+            if default == REQ:
+                problems.append(f"{table}.{key} is documented as required but may be left out")
+            value = _literal(default)
+            if value is not None and filled is not None and filled != value:
+                problems.append(f"{table}.{key}: documented default {default!r}, the parser fills in {filled!r}")
+    return problems
+
+
 def check() -> dict[str, set[str]]:
     have = accepted()
-    problems = []
+    problems = check_defaults()
     for table, keys in have.items():
         if table == "simulation":
             continue
