@@ -1,9 +1,14 @@
 """A griffe extension of the API reference: the docstrings' doctest examples (`>>>` lines and
 their output) are shown as Python console code blocks, as doctest reads them, instead of as
-running text."""
+running text; and Sphinx roles (``:class:`Settings` ``, ``:meth:`~phsplit.Solution.state` ``),
+which Markdown does not know, are shown as the code names they stand for."""
 from __future__ import annotations
 
+import re
+
 import griffe
+
+_ROLE = re.compile(r":(?:py:)?(?:class|meth|func|attr|mod|obj|data|exc):`~?([^`]+)`")
 
 
 def _fence(text: str) -> str:
@@ -30,5 +35,9 @@ def _fence(text: str) -> str:
 
 class DoctestBlocks(griffe.Extension):
     def on_object(self, *, obj, **kwargs) -> None:  # griffe 1.x and 2.x
-        if obj.docstring is not None and ">>>" in obj.docstring.value:
-            obj.docstring.value = _fence(obj.docstring.value)
+        if obj.docstring is None:
+            return
+        value = _ROLE.sub(r"`\1`", obj.docstring.value)
+        if ">>>" in value:
+            value = _fence(value)
+        obj.docstring.value = value
