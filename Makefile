@@ -8,12 +8,12 @@ BIN    := $(VENV)/bin
 OUT    ?= out
 RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
 
-.PHONY: run test test-rust test-python build reproduce bench bench-quick fuzz elliptic-refs rigid-body-refs capytaine-box clean
+.PHONY: run test test-rust test-python docs build reproduce bench bench-quick fuzz elliptic-refs rigid-body-refs capytaine-box clean
 
 run: $(VENV)/.built
 	$(BIN)/phsplit simulate --out $(OUT)
 
-test: test-rust test-python
+test: test-rust test-python docs
 
 test-rust:
 	cargo test -p phsplit-core -p phsplit-fmu --release
@@ -22,6 +22,16 @@ test-python: $(VENV)/.built
 	$(BIN)/python -m pytest -q python/tests
 
 build: $(VENV)/.built
+
+# The documentation site (mkdocs.yml; docs/about.md), built strictly into site/: any warning,
+# broken link or failing example fails it. Every example of the pages runs in the build, with
+# the package of .venv and its `phsplit` command.
+$(VENV)/.docs-deps: $(VENV)/.deps python/requirements-docs.txt
+	$(BIN)/python -m pip install --quiet -r python/requirements-docs.txt
+	touch $@
+
+docs: $(VENV)/.built $(VENV)/.docs-deps
+	PATH=$(abspath $(BIN)):$$PATH NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 
 $(VENV)/.deps: python/requirements-dev.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)

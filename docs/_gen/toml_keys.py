@@ -1,0 +1,351 @@
+"""Writes the TOML reference (docs/reference/toml.md runs it during the build).
+
+Which keys exist is asked of the code itself: the core's settings table
+(``phsplit._core.settings_keys``, ``default_settings``) and, for every other table, the list of
+allowed keys that the parser prints when it meets an unknown one. Units, defaults and meanings
+are written below from the modules that read each table (their module docs, named in SOURCE).
+The build fails when the two disagree: a key the code accepts and this file does not describe,
+a key described here that the code no longer accepts, a key documented as required that may be
+left out (or the reverse), or a literal default that is not what the parser fills in. Units and
+meanings are not checked: they drift only with the modules they were written from.
+"""
+from __future__ import annotations
+
+import copy
+import re
+
+import phsplit
+from phsplit import _core, batch, scenario, sea
+
+REQ = "required"
+OPT = "optional"
+
+# (unit, default, meaning). Units are SI; "-" means dimensionless or not a number.
+KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
+    "vessel": {
+        "mass": ("kg", REQ, "rigid-body mass `mv` (paper App. D)"),
+        "inertia": ("kg m²", REQ, "principal moments of inertia `T1, T2, T3` about the centre of gravity"),
+        "center_of_gravity": ("m", "[0, 0, 0]", "centre of gravity from the body origin, body frame, z up (§5.14)"),
+        "added_mass": ("kg, kg m, kg m²", "none", "6×6 symmetric added mass `M_A`; `M = M_RB + M_A` must be positive definite (§5.14)"),
+        "damping_translational": ("kg/s", REQ + " (or `damping_matrix`)", "diagonal linear damping `Dt`, ≥ 0 (§2.4)"),
+        "damping_rotational": ("kg m²/s", REQ + " (or `damping_matrix`)", "diagonal linear damping `Dr`, ≥ 0 (§2.4)"),
+        "damping_matrix": ("SI per entry", "none", "full 6×6 linear damping, symmetric positive semidefinite, instead of the diagonals (§5.13)"),
+        "gm_transverse": ("m", REQ, "transverse metacentric height, > 0 (§2.3)"),
+        "gm_longitudinal": ("m", REQ, "longitudinal metacentric height, > 0 (§2.3)"),
+        "gravity": ("m/s²", REQ, "acceleration of gravity, > 0"),
+        "water_density": ("kg/m³", REQ, "water density, > 0"),
+        "waterplane_area": ("m²", REQ, "waterplane area `A_wp`, > 0 (heave stiffness `ρ g A_wp`)"),
+        "flotation_center_x": ("m", "0", "centre of flotation, body x; couples heave and pitch (§5.15)"),
+        "flotation_center_y": ("m", "0", "centre of flotation, body y; couples heave and roll (§5.15)"),
+    },
+    "initial": {
+        "euler": ("rad", REQ, "ZYX Euler angles (roll, pitch, yaw), eq. (21)"),
+        "position": ("m", REQ, "position of the body origin, spatial frame, z up"),
+        "velocity": ("m/s", "[0, 0, 0]", "linear velocity, body frame"),
+        "angular_velocity": ("rad/s", "[0, 0, 0]", "angular velocity, body frame"),
+    },
+    "control": {
+        "kp_translational": ("N/m", REQ, "proportional gains on the position error (diagonal, ≥ 0; paper §3.1)"),
+        "kd_translational": ("N s/m", REQ, "derivative gains, booked as `control_damping`"),
+        "ki_translational": ("N/(m s)", REQ, "integral gains"),
+        "kp_rotational": ("N m/rad", REQ, "proportional gains on the Euler-angle error"),
+        "kd_rotational": ("N m s/rad", REQ, "derivative gains"),
+        "ki_rotational": ("N m/(rad s)", REQ, "integral gains"),
+        "euler_reference": ("rad", REQ, "set attitude (roll, pitch, yaw)"),
+        "position_reference": ("m", REQ, "set position, spatial frame"),
+    },
+    "external": {
+        "force": ("N", "[0, 0, 0]", "constant force (§5.4)"),
+        "moment": ("N m", "[0, 0, 0]", "constant moment"),
+        "point": ("m", "[0, 0, 0]", "point of application, body frame, each component within ±1000 m"),
+        "frame": ("-", '"body"', '`"body"` or `"spatial"`: the frame of `force` and `moment`'),
+    },
+    "current": {
+        "velocity": ("m/s", "[0, 0, 0]", "uniform current, spatial frame, towards; each component within ±10 m/s (§5.5)"),
+        "times": ("s", "none", "instead of `velocity`: increasing times of a current table"),
+        "velocities": ("m/s", "none", "one row of 3 numbers per time; linear in between, constant outside"),
+    },
+    "damping_quadratic": {
+        "coefficients": ("kg/m (surge, sway, heave), kg m² (roll, pitch, yaw)", REQ,
+                         "six magnitudes `≥ 0` of Fossen's `X_|u|u … N_|r|r` (§5.11)"),
+    },
+    "crossflow_drag": {
+        "draft": ("m", REQ, "draught `T`, > 0 (§5.12)"),
+        "drag_coefficient": ("-", REQ, "2-D drag coefficient `C_d`, in (0, 5]"),
+        "x_aft": ("m", REQ, "body x of the aft end of the hull, within ±1000 m"),
+        "x_fore": ("m", REQ, "body x of the fore end, `x_aft < x_fore`"),
+    },
+    "pipe": {
+        "submerged_weight": ("N/m", REQ, "pipe weight in water `w`, > 0 (§5.6)"),
+        "water_depth": ("m", REQ, "seabed below the still water line, > 0"),
+        "hang_off": ("m", REQ, "where the pipe leaves the vessel, body frame, above the seabed"),
+        "horizontal_tension": ("N", "one of four", "horizontal tension `H`, held by the tensioner"),
+        "top_tension": ("N", "one of four", "top tension `T`, instead"),
+        "departure_angle": ("degrees", "one of four", "angle from the horizontal at the hang-off point, in (0, 90)"),
+        "touchdown": ("m", "one of four", "`[x, y]` of the touchdown point, spatial"),
+        "lay_direction": ("degrees", "required with a tension or an angle", "lay direction, spatial, from x towards y"),
+        "lay_speed": ("m/s", "0", "with `touchdown`: speed of the touchdown point along `lay_direction`"),
+    },
+    "setpoint": {
+        "natural_frequency": ("rad/s", REQ, "ω of Fossen's third-order reference model, > 0 (§5.7)"),
+        "relative_damping": ("-", "1", "ζ, > 0 (1: critically damped)"),
+        "positions": ("m", REQ, "rows of 3 numbers, spatial: the set points or waypoints"),
+        "headings": ("rad", "the fixed heading", "one yaw per row"),
+        "times": ("s", "one of `times`, `speed`", "increasing times of the rows"),
+        "speed": ("m/s", "one of `times`, `speed`", "rows are waypoints passed at this speed, > 0"),
+        "start_time": ("s", "0", "with `speed`: when the set point starts moving"),
+        "interpolation": ("-", '"linear"', '`"linear"` or `"step"` between rows'),
+    },
+    "thrusters": {
+        "hull_length": ("m", REQ, "the hull's box `|x| ≤ L/2`, inside which every thruster sits (§5.8)"),
+        "hull_beam": ("m", REQ, "the box's `|y| ≤ B/2`, `|z| ≤ B/2`"),
+        "unit": ("-", REQ, "the list of thrusters, `[[thrusters.unit]]` tables (below); rank 3 in surge, sway and yaw"),
+    },
+    "thrusters.unit": {
+        "kind": ("-", REQ, '`"tunnel"`, `"azimuth"` or `"fixed"`'),
+        "position": ("m", REQ, "body frame, from the body origin"),
+        "max_thrust": ("N", REQ, "> 0"),
+        "min_thrust": ("N", "−max_thrust (tunnel); required (fixed)", "tunnel and fixed: the reverse thrust, < 0"),
+        "angle": ("degrees", "90 (tunnel), 0 (fixed)", "tunnel and fixed: the axis in the body x–y plane, from x towards y"),
+        "weight": ("-", "1", "cost of its thrust in the allocation, > 0"),
+        "thrust_rate": ("N/s", "none", "fastest change of thrust, > 0"),
+        "turn_rate": ("degrees/s", "none", "azimuth: fastest turn, > 0"),
+    },
+    "waves": {
+        "frequencies": ("rad/s", REQ, "ω_k of the sea state's components, > 0 (realised by `phsplit.sea`; §5.9)"),
+        "amplitudes": ("m", REQ, "a_k, ≥ 0"),
+        "phases": ("rad", REQ, "φ_k"),
+        "directions": ("degrees", REQ, "β_k, the direction each component travels towards"),
+        "rao_frequencies": ("rad/s", REQ, "increasing, covering every component's frequency"),
+        "rao_directions": ("degrees", REQ, "relative to the hull, increasing, spanning less than 360"),
+        "force_rao_real": ("N/m, N m/m", REQ, "`[direction][frequency][6]`, real part of the excitation per metre of amplitude"),
+        "force_rao_imag": ("N/m, N m/m", REQ, "imaginary part, the same shape"),
+        "drift_coefficients": ("N/m², N m/m²", "none", "`[direction][frequency][3]`, mean drift in surge, sway, yaw (Newman)"),
+        "phase_at": ("-", '"reference"', '`"reference"` (a fixed point) or `"vessel"` (the body origin)'),
+    },
+    "wind": {
+        "speed": ("m/s", REQ, "mean wind speed, ≥ 0, ≤ 80 (§5.10)"),
+        "direction": ("degrees", REQ, "the direction the wind blows towards, spatial"),
+        "gust_frequencies": ("rad/s", "together: all three or none", "gust components (realised by `phsplit.sea.Wind`), > 0"),
+        "gust_amplitudes": ("m/s", "together: all three or none", "≥ 0"),
+        "gust_phases": ("rad", "together: all three or none", "one per gust component"),
+        "frontal_area": ("m²", REQ, "frontal projected area `A_F`, > 0"),
+        "lateral_area": ("m²", REQ, "lateral projected area `A_L`, > 0"),
+        "length": ("m", REQ, "length `L` for the yaw moment, > 0"),
+        "air_density": ("kg/m³", REQ, "> 0"),
+        "angles": ("degrees", REQ, "relative wind angles of the coefficient table, increasing, spanning less than 360"),
+        "cx": ("-", REQ, "surge coefficient per angle"),
+        "cy": ("-", REQ, "sway coefficient per angle"),
+        "cn": ("-", REQ, "yaw coefficient per angle"),
+    },
+    "simulation": {},  # from the core's settings table, below
+    "environment.waves": {
+        "hs": ("m", REQ, "significant wave height"),
+        "tp": ("s", REQ, "peak period"),
+        "gamma": ("-", "3.3", "JONSWAP peak enhancement"),
+        "spectrum": ("-", '"jonswap"', '`"jonswap"` or `"pierson-moskowitz"`, through wavespectra'),
+        "direction": ("degrees", "0", "the direction the waves travel towards"),
+        "spreading": ("-", "none (long-crested)", "exponent `s` of the cos-2s spreading function"),
+        "seed": ("-", "0", "the same seed, the same sea"),
+        "components": ("-", "200", "number of regular components, 1 to 10,000"),
+        "omega_range": ("rad/s", "[0.5, 3] ω_p", "two increasing frequencies > 0"),
+        "hydro": ("-", "none", "a Capytaine dataset (path relative to the scenario) for the transfer functions"),
+        "symmetric": ("-", "false", "mirror 0–180 degrees for a port–starboard symmetric hull"),
+    },
+    "environment.wind": {
+        "speed": ("m/s", REQ, "mean speed at 10 m"),
+        "direction": ("degrees", "0", "towards"),
+        "spectrum": ("-", '"npd"', '`"npd"`, `"harris"` or `"none"`: the gust spectrum'),
+        "seed": ("-", "0", "the gusts' seed"),
+        "components": ("-", "100", "number of gust components"),
+        "omega_range": ("rad/s", "[0.001, 0.5]", "gust frequency range (the slowly-varying band)"),
+        "height": ("m", "10", "reference height of `speed`"),
+        "drag": ("-", "0.002", "surface drag coefficient of the Harris spectrum"),
+        "ship_type": ("-", "none", "Blendermann's (1994) coefficients for one of `phsplit.sea.blendermann`'s ship types"),
+        "centroid_x": ("m", "0", "with `ship_type`: body x of the lateral area's centroid"),
+        "frontal_area": ("m²", "the vessel file's", "as in `[wind]`"),
+        "lateral_area": ("m²", "the vessel file's", "as in `[wind]`"),
+        "length": ("m", "the vessel file's", "as in `[wind]`"),
+        "air_density": ("kg/m³", "the vessel file's", "as in `[wind]`"),
+        "angles": ("degrees", "from `ship_type`", "as in `[wind]`"),
+        "cx": ("-", "from `ship_type`", "as in `[wind]`"),
+        "cy": ("-", "from `ship_type`", "as in `[wind]`"),
+        "cn": ("-", "from `ship_type`", "as in `[wind]`"),
+    },
+    "sweep": {
+        "mode": ("-", '"grid"', '`"grid"` (the product of the lists) or `"random"`'),
+        "samples": ("-", "required with random", "number of random cases"),
+        "seed": ("-", "0", "seed of the random cases"),
+        "parameters": ("-", REQ, "a table: parameter path → list (grid, or choice) or `{low, high}` (uniform)"),
+    },
+}
+
+SOURCE = {
+    "vessel": "`model/vessel/body.rs`, `forces/damping.rs`, `forces/restoring.rs`",
+    "initial": "`model/vessel/mod.rs`",
+    "control": "`forces/pid.rs`",
+    "external": "`forces/external.rs`",
+    "current": "`forces/current.rs`",
+    "damping_quadratic": "`forces/damping_quadratic.rs`",
+    "crossflow_drag": "`forces/crossflow.rs`",
+    "pipe": "`forces/pipe.rs`",
+    "setpoint": "`forces/pid.rs`",
+    "thrusters": "`forces/thrusters.rs`",
+    "thrusters.unit": "`forces/thrusters.rs`",
+    "waves": "`forces/waves.rs`",
+    "wind": "`forces/wind.rs`",
+    "simulation": "`crates/phsplit-core/src/settings.rs`",
+    "environment.waves": "`python/src/phsplit/sea.py` (`sea_state`)",
+    "environment.wind": "`python/src/phsplit/sea.py` (`wind`)",
+    "sweep": "`python/src/phsplit/batch.py` (`load_sweep`)",
+}
+
+
+def _allowed(message: str) -> set[str]:
+    m = re.search(r"\(allowed: ([^)]*)\)", str(message))
+    if not m:
+        raise RuntimeError(f"no list of allowed keys in {message!r}")
+    return {k.strip() for k in m.group(1).split(",")}
+
+
+def _probe(call) -> set[str]:
+    try:
+        call()
+    except (_core.InvalidInputError, _core.ScenarioParseError) as e:
+        return _allowed(e)
+    raise RuntimeError("an unknown key was accepted")
+
+
+def accepted() -> dict[str, set[str]]:
+    """The keys each table accepts, as the code itself lists them."""
+    paper = phsplit.Vessel.paper().to_dict()
+    examples = [paper,
+                scenario.load("pipelay").vessel.to_dict(),
+                scenario.load("dp-weather").vessel.to_dict(),
+                phsplit.Vessel.preset("osv").to_dict(),
+                {**paper, "external": {"force": [1.0, 0.0, 0.0]},
+                 "damping_quadratic": {"coefficients": [0.0] * 6}}]
+    out: dict[str, set[str]] = {}
+    for table in _core.vessel_tables():
+        src = next(d for d in examples if table in d)
+        d = copy.deepcopy(src)
+        d[table]["zz_unknown"] = 0
+        out[table] = _probe(lambda: phsplit.Vessel.from_dict(d))
+    units = set()
+    pipelay = scenario.load("pipelay").vessel.to_dict()
+    for kind in ("tunnel", "azimuth", "fixed"):
+        d = copy.deepcopy(pipelay)
+        u = d["thrusters"]["unit"][0]
+        u.update(kind=kind, zz_unknown=0)
+        if kind == "fixed":
+            u["min_thrust"] = -1.0e5
+        units |= _probe(lambda: phsplit.Vessel.from_dict(d))
+    out["thrusters.unit"] = units
+    out["simulation"] = {k for k, _ in _core.settings_keys()}
+    out["environment.waves"] = _probe(lambda: sea.sea_state({"hs": 1.0, "tp": 9.0, "zz_unknown": 0}))
+    out["environment.wind"] = _probe(lambda: sea.wind({"speed": 1.0, "zz_unknown": 0}))
+    out["sweep"] = set(batch.SWEEP_KEYS)
+    return out
+
+
+def _examples() -> dict[str, dict]:
+    """A valid vessel file (as tables) that has each vessel table."""
+    paper = phsplit.Vessel.paper().to_dict()
+    pipelay = scenario.load("pipelay").vessel.to_dict()
+    weather = scenario.load("dp-weather").vessel.to_dict()
+    return {"vessel": paper, "initial": paper, "control": paper, "external": {**paper, "external": {"force": [1.0, 0.0, 0.0]}},
+            "current": weather, "pipe": pipelay, "setpoint": pipelay, "thrusters": pipelay, "waves": weather,
+            "wind": weather, "crossflow_drag": phsplit.Vessel.preset("osv").to_dict(),
+            "damping_quadratic": {**paper, "damping_quadratic": {"coefficients": [1.0] * 6}}}
+
+
+def _literal(text: str):
+    """The value a documented default stands for, when it is one literal (else None)."""
+    import tomllib
+
+    try:
+        return tomllib.loads(f"x = {text}")["x"]
+    except tomllib.TOMLDecodeError:
+        return None
+
+
+def check_defaults() -> list[str]:
+    """Each documented default of a vessel table against the parser: a key documented as
+    required must be refused when absent, and a literal default must be what the parser fills
+    in when the key is left out (where it reports the value back)."""
+    problems = []
+    for table, d in _examples().items():
+        for key in list(d[table]):
+            unit, default, _ = KEYS[table][key]
+            e = copy.deepcopy(d)
+            del e[table][key]
+            try:
+                filled = phsplit.Vessel.from_dict(e).to_dict()[table].get(key)
+            except (_core.InvalidInputError, _core.ScenarioParseError):
+                if default == REQ:
+                    continue
+                if not default.startswith(("required", "one of", "together")):
+                    problems.append(f"{table}.{key} is documented with the default {default!r} but is required")
+                continue
+            if default == REQ:
+                problems.append(f"{table}.{key} is documented as required but may be left out")
+            value = _literal(default)
+            if value is not None and filled is not None and filled != value:
+                problems.append(f"{table}.{key}: documented default {default!r}, the parser fills in {filled!r}")
+    return problems
+
+
+def check() -> dict[str, set[str]]:
+    have = accepted()
+    problems = check_defaults()
+    for table, keys in have.items():
+        if table == "simulation":
+            continue
+        described = set(KEYS.get(table, {}))
+        if keys - described:
+            problems.append(f"[{table}] accepts {sorted(keys - described)}, not described in docs/_gen/toml_keys.py")
+        if described - keys:
+            problems.append(f"[{table}] no longer accepts {sorted(described - keys)}")
+    for table in KEYS:
+        if table not in have:
+            problems.append(f"[{table}] is described but no longer a table")
+    if problems:
+        raise RuntimeError("the TOML reference is out of date: " + "; ".join(problems))
+    return have
+
+
+def _row(key, unit, default, meaning):
+    return f"| `{key}` | {unit} | {default} | {meaning} |"
+
+
+def table_md(table: str, have: dict[str, set[str]]) -> str:
+    lines = [f"| key | unit | default | meaning |", "|---|---|---|---|"]
+    if table == "simulation":
+        defaults = _core.default_settings()
+        for key, what in _core.settings_keys():
+            d = defaults.get(key)
+            d = "the file's name" if d is None and key == "name" else ("`" + _core.dumps_toml({"x": d}).split("=", 1)[1].strip() + "`" if d is not None else "–")
+            unit = "s" if key in ("t_span", "h", "control_start") else "-"
+            lines.append(_row(key, unit, d, what))
+    else:
+        for key, (unit, default, meaning) in KEYS[table].items():
+            lines.append(_row(key, unit, default, meaning))
+    return "\n".join(lines)
+
+
+def render() -> str:
+    have = check()
+    parts = []
+    groups = [
+        ("Scenario files", ["simulation", "environment.waves", "environment.wind"]),
+        ("Vessel files (and any scenario, table by table)",
+         ["vessel", "initial", "control", "external", "current", "damping_quadratic", "crossflow_drag",
+          "pipe", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
+        ("Sweep files", ["sweep"]),
+    ]
+    for title, tables in groups:
+        parts.append(f"## {title}\n")
+        for t in tables:
+            name = "[[thrusters.unit]]" if t == "thrusters.unit" else f"[{t}]"
+            parts.append(f"### `{name}`\n\nRead by {SOURCE[t]}.\n\n{table_md(t, have)}\n")
+    return "\n".join(parts)
