@@ -1,4 +1,4 @@
-"""The vessel FMU's speed (issue 15): a one-hour run of the paper's vessel (Fig. 2 settings, SP4,
+"""The vessel FMU's speed: a one-hour run of the paper's vessel (Fig. 2 settings, SP4,
 the controller from 50 s) with 0.1 s communication steps and the internal step h = 0.1 s, in
 FMPy (``simulate_fmu``, recording ten outputs, and a bare ``doStep`` loop through FMPy's
 ``FMU2Slave``, with constant inputs and with the external force changed every step, as a

@@ -1,4 +1,4 @@
-"""The general vessel (issue 18): the offshore supply vessel preset (Fossen's MSS osv.m: full added
+"""The general vessel: the offshore supply vessel preset (Fossen's MSS osv.m: full added
 mass, CG off the origin, cross-flow drag) in its DP scenario for one hour.
 
 1. Time per step of SP2/SP4 (flow S2 by Gauss collocation, which the cross-flow drag's forcing

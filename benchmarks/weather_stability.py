@@ -1,4 +1,4 @@
-"""Stability under weather (issue 11): the shipped dp-weather scenario (the paper's vessel in a
+"""Stability under weather: the shipped dp-weather scenario (the paper's vessel in a
 rough sea, a near gale and a current, one hour) with SP2 at h = 1 s against RK4 at the same step
 and at its own largest stable step, and against scipy's DOP853 on phsplit's compiled vector field (`phsplit._core.VectorField`).
 

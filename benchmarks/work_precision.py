@@ -109,7 +109,7 @@ def fixed_step_runs(ref_: Reference, quick: bool) -> list[dict]:
     for meth, lf in methods:
         hs = all_hs
         # On [0, 3600] only SP2 needs the two shortest steps to reach a final error of 1e-6
-        # (issue 17's target; second order, 4.3e-6 at h = 1/16 with the exact S2).
+        # (the speed target; second order, 4.3e-6 at h = 1/16 with the exact S2).
         if T > 1000 and meth != "sp2":
             hs = hs[:6]
         if quick:
@@ -439,7 +439,7 @@ def main() -> int:
         split = min(v for k, v in best.items() if k[0] in ("phsplit sp2", "phsplit sp4", "phsplit sp6"))
         rk4 = best.get(("phsplit rk4", "-", "core"), math.inf)
         dop = best.get(("compiled DOP853", "-", "core"), math.inf)
-        L += [f"### Issue 17's targets at final error 1e-6 on [0, {T:g}] s", "",
+        L += [f"### Targets at final error 1e-6 on [0, {T:g}] s", "",
               "Ratios of times to the same final error, core against core, measured in the same run "
               "(the issue asks ≥ 1×, with 3× as the goal beyond it).", ""]
         if T > 1000:

@@ -13,7 +13,7 @@ double:
     ``(u, k)``; the parameter here is ``m = fl(k*k)``, so ``jacobi_near_1`` gives ``m > 1``);
   - an adversarial grid (set ``edge``): ``m`` from 0, 5e-324, 1e-300 ... through 1 - 1e-3 ...
     1 - 2**-53, 1 (and a few ``m < 0``, ``m > 1``), ``u`` from +-0 and subnormals to 1e15,
-    including ``fl(n K(m))`` and its neighbours one ulp away, and the inputs of issue 16.
+    including ``fl(n K(m))`` and its neighbours one ulp away, and the inputs of the edge cases (tests/exact_at_the_edges.rs).
 * ``ellint_ref.csv``: K and F (set,function,phi,m,value,sensitivity) at the inputs of Boost.Math's
   ``ellint_k_data`` (``m = fl(k*k)``) and ``ellint_f_data`` (``(phi, m = fl(k*k))``), and an
   adversarial grid (set ``edge``). ``sensitivity`` is F's own conditioning limit: the largest
@@ -61,7 +61,7 @@ U_EDGE = [0.0, -0.0, 5e-324, -5e-324, 1e-310, 1e-300, 1e-20, 1e-8, -1e-8, 2.0**-
           -709.0, 711.0, 1000.0, 3000.0, 1e4, 1e5, 1e6, 1e8, 1e10, 1e12, 1e15, -1e15]
 U_OUTSIDE = [0.0, 1e-300, 1e-8, 0.5, -0.5, 1.0, 2.0, 3.0, 7.5, 20.0, 100.0, 1e4]
 N_PERIODS = [1, 2, 3, 4, 5, 8, 101, 1001, 10**6 + 1, 10**12 + 3, 10**14 + 1]
-# the inputs of issue 16, item 1
+# the edge-case inputs (tests/exact_at_the_edges.rs)
 U_ISSUE = [(709.0, 0.9990000000000001), (605.1505233912122, 0.9999), (375.0, 0.9999),
            (625.0, 0.9999999999999999), (711.0, 0.9990000000000001), (1e15, 0.9999)]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Write the mpmath reference table for the exact free-rigid-body momentum (issue 16).
+"""Write the mpmath reference table for the exact free-rigid-body momentum.
 
 Output: crates/phsplit-core/tests/data/rigid_body_ref.csv, one row per (body, m0, t):
 
@@ -16,7 +16,7 @@ digits) at every row with t <= 50 and at the rows marked for it at t = 1000; the
 they differ by more than 1e-20 relative to |m0| (or the sensitivity's tenth part, whichever is
 larger).
 
-Cases: the input of issue 16 (T = (1, 2, 3), m0 = (1e-7, 1, 2e-7)); random bodies; near-symmetric
+Cases: a start next to the unstable middle axis (T = (1, 2, 3), m0 = (1e-7, 1, 2e-7)); random bodies; near-symmetric
 bodies (relative inertia gaps 1e-6 ... 1e-14, the middle inertia next to either end); states
 next to the separatrix (k'^2 from 1e-4 to 1e-15, either side); states next to the middle axis
 (and the other two); t from 0.5 to 1000.
@@ -126,7 +126,7 @@ def sensitivity(inertia, m0, t, ref) -> float:
 
 def cases() -> list[tuple[str, tuple, tuple, list[float], bool]]:
     """(label, inertia, m0, times, check t = 1000 against the ODE too)."""
-    out = [("issue16 middle axis", (1.0, 2.0, 3.0), (1e-7, 1.0, 2e-7), TIMES, True)]
+    out = [("near the middle axis", (1.0, 2.0, 3.0), (1e-7, 1.0, 2e-7), TIMES, True)]
     rng = random.Random(16)
     for k in range(6):
         inertia = tuple(rng.uniform(0.2, 5.0) for _ in range(3))

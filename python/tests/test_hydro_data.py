@@ -222,6 +222,27 @@ def test_the_cli_refuses_a_bad_dataset_with_one_line_and_exit_2(tmp_path, capsys
     assert not (tmp_path / "out").exists() or not os.listdir(tmp_path / "out")
 
 
+def test_a_scenario_uses_a_failing_dataset_only_when_it_asks_with_hydro_checks(tmp_path):
+    from phsplit import scenario
+
+    _scaled(raw(), "excitation_force", "Heave", 0.04).to_netcdf(tmp_path / "barge.nc")
+    head = ('[simulation]\nt_span = [0.0, 10.0]\nh = 0.5\n\n[environment.waves]\nhs = 2.0\ntp = 8.0\n'
+            'omega_range = [0.35, 1.9]\nhydro = "barge.nc"\nsymmetric = true\n')
+    for value, outcome in [(None, "refused"), ('"refuse"', "refused"), ('"warn"', "warned"), ('"off"', "bad key")]:
+        sc = tmp_path / "sea.toml"
+        sc.write_text(head + (f"hydro_checks = {value}\n" if value else ""))
+        if outcome == "refused":
+            with pytest.raises(phsplit.InvalidInputError, match="long-wave heave"):
+                scenario.load(sc)
+        elif outcome == "warned":
+            with pytest.warns(hydro.HydroDataWarning, match="long-wave heave"):
+                s = scenario.load(sc)
+            assert "waves" in s.vessel.components
+        else:
+            with pytest.raises(phsplit.ScenarioParseError, match=r"hydro_checks must be one of 'refuse', 'warn', got 'off'"):
+                scenario.load(sc)
+
+
 # -- the reference point ------------------------------------------------------------------------
 
 def _moved(A, r):

@@ -97,3 +97,19 @@ def test_its_fmu_validates_and_exposes_every_account(osv_weather, tmp_path):
         scale = np.abs(ref).max()
         assert scale > 0, name
         assert np.abs(r[name] - ref).max() <= 1e-9 * scale, name
+
+
+def test_the_exact_flow_that_cannot_act_says_so():
+    """A forcing part (the OSV's cross-flow drag) leaves flow S2 to Gauss collocation: asking for
+    the exact flow is answered with a SettingWarning saying what the run used, and the run is the
+    Gauss one bit for bit; on the paper's vessel the exact flow acts and nothing is said."""
+    import warnings
+
+    osv = phsplit.Vessel.preset("osv")
+    with pytest.warns(phsplit.SettingWarning, match="the run used linear_flow = 'gauss'"):
+        exact = phsplit.simulate(osv, (0.0, 10.0), 0.5, "sp2", 0.0, linear_flow="exact")
+    gauss = phsplit.simulate(osv, (0.0, 10.0), 0.5, "sp2", 0.0, linear_flow="gauss")
+    assert np.array_equal(exact.x, gauss.x) and np.array_equal(exact.m, gauss.m)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", phsplit.SettingWarning)
+        phsplit.simulate(phsplit.Vessel.paper(), (0.0, 10.0), 0.5, "sp2", 0.0, linear_flow="exact")

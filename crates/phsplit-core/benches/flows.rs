@@ -91,7 +91,7 @@ fn flows(c: &mut Criterion) {
             c.bench_function(&label, |b| {
                 b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
             });
-            // With the ledger (issue 17's measure of a step: every account booked).
+            // With the ledger (a step's cost with every account booked).
             if let Method::Splitting(_) = method {
                 let opts = Options {
                     ledger: true,

@@ -1,11 +1,11 @@
-//! sn, cn, dn, K and F against mpmath over the whole domain (issue 16): at the inputs of
+//! sn, cn, dn, K and F against mpmath over the whole domain: at the inputs of
 //! Boost.Math's published test tables and on an adversarial grid (m from 0 and 5e-324 to
 //! 1 − 2⁻⁵³ and 1, a few m outside [0, 1]; u from ±0 and subnormals to 1e15, with n·K ± 1 ulp).
 //!
 //! Tables: `tests/data/jacobi_ref.csv` and `tests/data/ellint_ref.csv`, written by
 //! `scripts/gen_elliptic_refs.py` (mpmath at 60 digits, confirmed at 90).
 //!
-//! Bounds (issue 16):
+//! Bounds:
 //! * sn, cn, dn: within 8 ulp of the value, or within `4 ε |u|` absolute, the error that the
 //!   argument reduction of a function of slope ≤ 1 may cost (ε = 2⁻⁵²). Outside `0 ≤ m ≤ 1`
 //!   the slopes reach `max(1, |m|)` (`dn' = −m sn cn`), and the absolute allowance is scaled
@@ -130,7 +130,7 @@ fn elliptic_integrals_within_the_issue_16_bounds_over_the_whole_domain() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The flow's short path (issue 17: the Maclaurin series of sn, cn, dn for the small phase
+/// The flow's short path (the Maclaurin series of sn, cn, dn for the small phase
 /// advances of a step) against mpmath, on every row of the table with `0 < |u| ≤ 0.01` and
 /// `0 ≤ m ≤ 1`: within 1 ulp (the AGM path's bound is 8, its measured worst 3).
 #[test]

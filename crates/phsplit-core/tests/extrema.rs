@@ -1,4 +1,4 @@
-//! Issue 14: summaries from every step. The running maxima of the controller's force and moment
+//! Summaries from every step. The running maxima of the controller's force and moment
 //! must equal the maxima over every step's state, also when only every 50th state is saved.
 use phsplit_core::model::vessel::{Vessel, VesselState, VesselSystem};
 use phsplit_core::settings::Settings;

@@ -1,4 +1,4 @@
-//! Issue 17, item 1: the restoring invariant `c = mu − G Qᵀe3` (docs/model.md §3.6).
+//! The restoring invariant `c = mu − G Qᵀe3` (docs/model.md §3.6).
 //!
 //! The true equilibrium of the paper's vessel under its controller is upright: nothing in the
 //! model applies a heeling or trimming moment at rest (the controller acts in surge, sway and
@@ -92,7 +92,7 @@ fn invariant_scale(v: &Vessel) -> f64 {
 
 #[test]
 fn without_the_projection_the_split_comes_to_rest_tilted() {
-    // The defect the projection removes (issue 17 measured 7.9e-5 rad of pitch for SP2 at
+    // The defect the projection removes (measured: 7.9e-5 rad of pitch for SP2 at
     // h = 0.2 s), and Runge–Kutta, which keeps the linear invariant by itself.
     let (_, sp2) = final_state("sp2", 0.2, 3600.0, false);
     assert!(sp2.euler().y.abs() > 1e-6, "pitch {:.3e}", sp2.euler().y);

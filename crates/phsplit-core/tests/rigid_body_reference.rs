@@ -1,4 +1,4 @@
-//! The exact free-rigid-body momentum against mpmath (issue 16): random bodies, near-symmetric
+//! The exact free-rigid-body momentum against mpmath: random bodies, near-symmetric
 //! bodies (relative inertia gaps 1e-6 … 1e-14), states next to the separatrix and next to the
 //! middle axis, t up to 1,000.
 //!

@@ -1,4 +1,4 @@
-//! phsplit-fmu: a phsplit vessel as an FMI 2.0 co-simulation FMU (issue 15; docs/fmu.md).
+//! phsplit-fmu: a phsplit vessel as an FMI 2.0 co-simulation FMU (docs/fmu.md).
 //!
 //! The `cdylib` is the FMU's binary (`binaries/linux64/phsplit_fmu.so`), with no Python inside:
 //! the FMI 2.0 C API ([`ffi`]) over an instance stepping the vessel ([`instance`]) and the

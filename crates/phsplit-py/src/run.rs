@@ -98,6 +98,7 @@ fn integrate<'py>(
                     .with_projection(s2.project_invariants)
                     .with_extrema(extrema);
                 let traj = run_watched(&sys, &s2.method, y0, &opts, mon)?;
+                let s2_solver = sys.s2_solver();
                 // The force and moment of each account at the saved states.
                 let wrenches: Vec<_> = traj
                     .t
@@ -111,7 +112,7 @@ fn integrate<'py>(
                     .zip(&traj.states)
                     .map(|(t, s)| sys.outputs(s, *t))
                     .collect();
-                Ok::<_, Error>((traj, wrenches, outputs))
+                Ok::<_, Error>((traj, wrenches, outputs, s2_solver))
             }))
         })
         .map_err(|p| {
@@ -123,7 +124,7 @@ fn integrate<'py>(
             PhsplitError::new_err(format!("internal error in the phsplit core: {msg}"))
         })?
         .map_err(to_py)?;
-    let (traj, wrenches, outputs) = out;
+    let (traj, wrenches, outputs, s2_solver) = out;
     if let Some(e) = monitor.error.take() {
         if !e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
             return Err(e); // an exception of the progress callback, or of a signal handler
@@ -175,6 +176,13 @@ fn integrate<'py>(
     let kinds: Vec<&str> = traj.accounts.iter().map(|a| kind_name(a.kind)).collect();
     d.set_item("accounts", names)?;
     d.set_item("account_kinds", kinds)?;
+    let controls: Vec<&str> = traj
+        .accounts
+        .iter()
+        .filter(|a| a.role == phsplit_core::solve::Role::Control)
+        .map(|a| a.name)
+        .collect();
+    d.set_item("control_accounts", controls)?;
     let booked: Vec<f64> = traj.booked.iter().flat_map(|w| w.values(k)).collect();
     d.set_item("booked", PyArray1::from_vec(py, booked).reshape([n, k])?)?;
     let mut force = Vec::with_capacity(n * k * 3);
@@ -232,6 +240,9 @@ fn integrate<'py>(
     }
     d.set_item("running_max", ext)?;
     d.set_item("settings", settings_dict(py, &settings, None)?)?;
+    // How flow S2 was integrated: the chosen linear flow, or Gauss collocation where S2 has a
+    // forcing part (the exact flow cannot act on it).
+    d.set_item("s2_solver", s2_solver.name())?;
     match traj.status {
         Status::Completed => d.set_item("status", "completed")?,
         Status::Failed { step, t, reason } => {

@@ -56,7 +56,8 @@ from .batch import simulate_many, with_parameters
 from .results import open_dataset, open_sweep, rerun
 from .scenario import Scenario
 from .scenario import load as load_scenario
-from .simulate import Ledger, PassivityWarning, Settings, Solution, StepSizeWarning, Vessel, presets, simulate
+from .simulate import (Ledger, PassivityWarning, SettingWarning, Settings, Solution, StepSizeWarning, Vessel,
+                       presets, simulate)
 
 
 def method_info(name: str) -> dict:
@@ -70,6 +71,7 @@ __all__ = [
     "InvalidInputError",
     "Ledger",
     "PassivityWarning",
+    "SettingWarning",
     "PhsplitError",
     "Scenario",
     "ScenarioParseError",

@@ -337,7 +337,7 @@ def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
     sup = zero + sum((by_account[nm] for nm in names if kinds[nm] == "supplied"), zero)
     dis = zero + sum((by_account[nm] for nm in names if kinds[nm] == "dissipated"), zero)
     sol = solution_of(
-        {"t": t, **pick}, booked, names, kinds, sup, dis,
+        {"t": t, **pick}, booked, names, kinds, sup, dis, controls=tmpl.ledger.controls,
         status=status, method=tmpl.method, h=settings.h, control_start=settings.control_start, steps=steps,
         failure=failure, last_good_state=src[-1][0].state(src[-1][1]), meta=dict(tmpl.meta),
         settings={**tmpl.settings, "t_span": tuple(settings.t_span), "h": settings.h,

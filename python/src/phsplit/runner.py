@@ -19,6 +19,11 @@ class StepSizeWarning(UserWarning):
     passive and bounded (for the splitting methods) but cannot resolve that motion."""
 
 
+class SettingWarning(UserWarning):
+    """A run setting could not act as asked and the run says what it did instead (the exact
+    flow S2 on a vessel whose S2 has a forcing part, which Gauss collocation integrates)."""
+
+
 class PassivityWarning(UserWarning):
     """A composition with negative sub-steps created energy: its discrete map is passive only
     under the condition of the paper's Prop. 2.5, which this run does not meet."""
@@ -66,18 +71,18 @@ def _warn_if_step_too_long(vessel: Vessel, y0: np.ndarray | None, settings: Sett
 
 
 def solution_of(columns: dict[str, np.ndarray], booked: np.ndarray, names: list[str], kinds: dict[str, str],
-                supplied: np.ndarray, dissipated: np.ndarray, **rest) -> Solution:
+                supplied: np.ndarray, dissipated: np.ndarray, controls: tuple[str, ...] = (), **rest) -> Solution:
     """The one constructor of a :class:`Solution`: the state ``columns`` at the saved times
     (``t``, ``x``, ``euler``, ``quaternion``, ``Q``, ``p``, ``m``, ``mu``, ``phi_th``,
     ``phi_x``, ``energy``, ``orthogonality_defect``, ``account_force``, ``account_moment``),
     the energy ``booked`` by each account in each saved interval ((N, accounts), first row
-    zero) with their ``kinds``, their totals ``supplied`` and ``dissipated``, and the run's
+    zero) with their ``kinds`` and the names of the controller's accounts (``controls``), their totals ``supplied`` and ``dissipated``, and the run's
     other fields (``status``, ``method``, ``h``, ...). The ledger's ``dH`` and levels come from
     the energy here, the same way for a single call and for a run assembled from several."""
     e = np.asarray(columns["energy"])
     ledger = Ledger(dH=np.concatenate([[0.0], np.diff(e)]) if len(e) else e, supplied=supplied,
                     dissipated=dissipated, by_account={n: booked[:, k] for k, n in enumerate(names)},
-                    kinds=dict(kinds), level=Ledger.level_of(e))
+                    kinds=dict(kinds), controls=tuple(controls), level=Ledger.level_of(e))
     return Solution(ledger=ledger, **columns, **rest)
 
 
@@ -98,13 +103,18 @@ def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, ort
     used = raw["settings"]
     e = raw["energy"]
     info = _core.method_info(used["method"])
+    if used["linear_flow"] == "exact" and raw["s2_solver"] != "exact" and info["kind"] == "splitting":
+        warnings.warn(SettingWarning(
+            "linear_flow = 'exact' cannot act on this vessel: its flow S2 has a forcing part (a load that is "
+            "not affine in the state, or that depends on time), which Gauss collocation of the method's order "
+            "integrates; the run used linear_flow = 'gauss' (docs/model.md §3.7)"), stacklevel=stacklevel)
     if used["ledger"] and info["kind"] == "splitting" and not info["all_positive"] and len(e) > 1:
         _warn_if_energy_created(raw, info, used["outer"], e, stacklevel)
     mass, inertia = vessel._body()
     names = list(raw["accounts"])
     sol = solution_of(
         {k: raw[k] for k in _COLUMNS}, raw["booked"], names, dict(zip(names, raw["account_kinds"])),
-        raw["supplied"], raw["dissipated"],
+        raw["supplied"], raw["dissipated"], controls=tuple(raw["control_accounts"]),
         status=raw["status"], method=info["name"], h=used["h"], control_start=used["control_start"],
         steps=raw["steps"], failure=raw.get("failure"), last_good_state=raw["last_good"],
         meta={"mass": mass, "inertia": inertia, "mass_matrix": vessel.mass_matrix,

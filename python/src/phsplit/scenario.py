@@ -252,7 +252,9 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
     coefficients come from the vessel file or from the same table; ``[environment.waves]`` is a sea state (``phsplit.sea``), realised
     into the ``[waves]`` component's components, with its transfer functions from a Capytaine
     dataset (``hydro = "file.nc"``, relative to the scenario; ``symmetric = true`` mirrors a
-    port–starboard symmetric hull's directions) or from the vessel file's own ``[waves]`` keys."""
+    port–starboard symmetric hull's directions; ``hydro_checks = "warn"`` uses a dataset that fails
+    a physics check with a warning instead of refusing it, docs/hydrodynamic-data.md) or from the
+    vessel file's own ``[waves]`` keys."""
     if not isinstance(env, Mapping):
         raise _core.ScenarioParseError(f"{path}: [environment] must be a table")
     allowed = ("current", "waves", "wind")
@@ -284,8 +286,12 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
             sym = w.get("symmetric", False)
             if not isinstance(sym, bool):
                 raise _core.ScenarioParseError(f"{path}: environment.waves.symmetric must be true or false, got {sym!r}")
+            checks = w.get("hydro_checks", "refuse")
+            if checks not in hydro.CHECK_MODES:
+                raise _core.ScenarioParseError(f"{path}: environment.waves.hydro_checks must be one of "
+                                               f"{', '.join(map(repr, hydro.CHECK_MODES))}, got {checks!r}")
             try:
-                table = hydro.from_capytaine(p, symmetric=sym)["waves"]
+                table = hydro.from_capytaine(p, symmetric=sym, checks=checks)["waves"]
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
         out["waves"] = {**table, **comps}

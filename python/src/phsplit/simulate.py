@@ -15,13 +15,13 @@ import numpy as np
 
 from . import _core, _provided
 from .events import run_with_outputs
-from .runner import PassivityWarning, StepSizeWarning, run
+from .runner import PassivityWarning, SettingWarning, StepSizeWarning, run
 from .settings import Settings, settings_to_toml
 from .solution import Ledger, Solution
 from .vessel import Vessel, presets
 
 __all__ = ["simulate", "Vessel", "Solution", "Ledger", "Settings", "presets", "settings_to_toml",
-           "StepSizeWarning", "PassivityWarning"]
+           "StepSizeWarning", "PassivityWarning", "SettingWarning"]
 
 
 def simulate(

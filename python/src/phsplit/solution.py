@@ -29,6 +29,9 @@ class Ledger:
     dissipated: np.ndarray
     by_account: dict[str, np.ndarray] = field(default_factory=dict)
     kinds: dict[str, str] = field(default_factory=dict)
+    #: The accounts of the controller's force (the core's accounts of the control role: its P, I
+    #: and D parts, or what its thrusters deliver), in the ledger's order.
+    controls: tuple[str, ...] = ()
     #: ``|H_n| + |H_{n-1}|`` per interval (the terms whose difference is ``dH``), or None.
     level: np.ndarray | None = None
 
@@ -110,6 +113,9 @@ class Solution:
         """Body-frame moment (N, 3) about the body origin of the named accounts, summed."""
         return self._by_account(self.account_moment, accounts)
 
+    def _zero_vector(self) -> np.ndarray:
+        return np.zeros((len(self.t), 3))
+
     def _by_account(self, arr, accounts) -> np.ndarray:
         names = list(self.ledger.by_account)
         unknown = [a for a in accounts if a not in names]
@@ -121,12 +127,12 @@ class Solution:
     @property
     def control_force(self) -> np.ndarray:
         """The controller's force (P, I and D terms; with thrusters, what they deliver), body frame (N, 3), N."""
-        return self.force(*[a for a in ("control", "control_damping", "thrusters") if a in self.ledger.by_account])
+        return self.force(*self.ledger.controls) if self.ledger.controls else self._zero_vector()
 
     @property
     def control_moment(self) -> np.ndarray:
         """The controller's moment (P, I and D terms; with thrusters, what they deliver), body frame (N, 3), N m."""
-        return self.moment(*[a for a in ("control", "control_damping", "thrusters") if a in self.ledger.by_account])
+        return self.moment(*self.ledger.controls) if self.ledger.controls else self._zero_vector()
 
     def at(self, times: Sequence[float] | np.ndarray) -> "Solution":
         """Dense output on request: the states at any ``times`` within the run, each computed by
