@@ -86,6 +86,11 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "lay_direction": ("degrees", "required with a tension or an angle", "lay direction, spatial, from x towards y"),
         "lay_speed": ("m/s", "0", "with `touchdown`: speed of the touchdown point along `lay_direction`"),
     },
+    "spring": {
+        "fairlead": ("m", REQ, "the fairlead, body frame, from the body origin, each component within ±1000 m (§5.16)"),
+        "anchor": ("m", REQ, "the anchor, spatial frame, z up"),
+        "stiffness": ("N/m", REQ, "the spring's stiffness `k`, > 0"),
+    },
     "setpoint": {
         "natural_frequency": ("rad/s", REQ, "ω of Fossen's third-order reference model, > 0 (§5.7)"),
         "relative_damping": ("-", "1", "ζ, > 0 (1: critically damped)"),
@@ -189,6 +194,7 @@ SOURCE = {
     "damping_quadratic": "`forces/damping_quadratic.rs`",
     "crossflow_drag": "`forces/crossflow.rs`",
     "pipe": "`forces/pipe.rs`",
+    "spring": "`forces/spring.rs`",
     "setpoint": "`forces/pid.rs`",
     "thrusters": "`forces/thrusters.rs`",
     "thrusters.unit": "`forces/thrusters.rs`",
@@ -256,7 +262,8 @@ def _examples() -> dict[str, dict]:
     return {"vessel": paper, "initial": paper, "control": paper, "external": {**paper, "external": {"force": [1.0, 0.0, 0.0]}},
             "current": weather, "pipe": pipelay, "setpoint": pipelay, "thrusters": pipelay, "waves": weather,
             "wind": weather, "crossflow_drag": phsplit.Vessel.preset("osv").to_dict(),
-            "damping_quadratic": {**paper, "damping_quadratic": {"coefficients": [1.0] * 6}}}
+            "damping_quadratic": {**paper, "damping_quadratic": {"coefficients": [1.0] * 6}},
+            "spring": {**paper, "spring": {"fairlead": [30.0, 0.0, 0.0], "anchor": [700.0, 0.0, -5.0], "stiffness": 1.0e4}}}
 
 
 def _literal(text: str):

@@ -1,5 +1,5 @@
 """An independent reference for the vessel, for the tests: eq. (39) of the paper written again in
-numpy, from docs/model.md §2 (and the external load of §5), integrated by scipy's DOP853 at
+numpy, from docs/model.md §2 (and the loads of §5), integrated by scipy's DOP853 at
 tight tolerance.
 
 Nothing here calls phsplit's integrators or its Rust vector field; only the initial state and
@@ -65,6 +65,10 @@ class Field:
         self.thr_units = list(thr["unit"]) if thr else None
         pipe = params.get("pipe")
         self.pipe = dict(pipe) if pipe else None
+        spr = params.get("spring")
+        # a linear spring from the fairlead r (body) to the anchor a (spatial): F = -k (x + Q r - a)
+        self.spring = (np.array(spr["fairlead"], float), np.array(spr["anchor"], float), float(spr["stiffness"])) \
+            if spr else None
         sp = params.get("setpoint")
         # the moving set point: the third-order filter's states are integrated with the vessel
         # (y[27:45]: x_d, x_d', x_d'' for the six channels), driven by the set point r(t)
@@ -259,6 +263,10 @@ class Field:
         if self.pipe is not None:
             fp = Q.T @ self.pipe_force(t, x, Q)
             fe, me = fe + fp, me + np.cross(np.array(self.pipe["hang_off"], float), fp)
+        if self.spring is not None:
+            r, a, k = self.spring
+            fs = Q.T @ (-k * (x + Q @ r - a))
+            fe, me = fe + fs, me + np.cross(r, fs)
         dy = np.empty(n)
         if n == 45:
             dy[27:45] = np.concatenate([f[1], f[2], jerk])

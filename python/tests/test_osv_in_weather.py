@@ -1,6 +1,6 @@
 """The OSV preset in the full shipped ``dp-weather`` sea: waves with drift, NPD wind, current and
 cross-flow drag, each a ledger account (nine, plus ``external`` in the FMU), for one hour with
-SP2 and SP4. The ledger has no ceiling on its accounts (docs/model.md §3.4): every source is
+SP2 and SP4. The ledger has no ceiling on its accounts (docs/model.md §3.5): every source is
 booked in its own account and ``ΔH = supplied − dissipated`` closes per step; the FMU of the
 vessel validates and exposes every account's energy, force and moment and every component's
 output, from the vessel's own declarations."""
@@ -110,6 +110,7 @@ def test_the_exact_flow_that_cannot_act_says_so():
         exact = phsplit.simulate(osv, (0.0, 10.0), 0.5, "sp2", 0.0, linear_flow="exact")
     gauss = phsplit.simulate(osv, (0.0, 10.0), 0.5, "sp2", 0.0, linear_flow="gauss")
     assert np.array_equal(exact.x, gauss.x) and np.array_equal(exact.m, gauss.m)
+    assert exact.to_xarray().attrs["s2_solver"] == "gauss" and exact.settings["linear_flow"] == "exact"
     with warnings.catch_warnings():
         warnings.simplefilter("error", phsplit.SettingWarning)
         phsplit.simulate(phsplit.Vessel.paper(), (0.0, 10.0), 0.5, "sp2", 0.0, linear_flow="exact")

@@ -1,7 +1,8 @@
 //! One SP2 step of a preset vessel with the ledger and the default projection, run `reps` times
 //! over 1,000 steps (h = 0.05 s): for counting a step's instructions (`perf stat -e
 //! instructions:u`) where timings are too noisy. Run:
-//! `cargo run --release -p phsplit-core --example vessel_steps -- osv exact 200`.
+//! `cargo run --release -p phsplit-core --example vessel_steps -- osv exact 200` (a preset's
+//! name or a vessel file).
 use nalgebra::Vector3;
 use phsplit_core::methods::{Method, Outer};
 use phsplit_core::model::vessel::{LinearFlow, Vessel, VesselSystem};
@@ -16,7 +17,12 @@ fn main() {
         _ => LinearFlow::Exact,
     };
     let reps: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(100);
-    let vessel = Vessel::preset(name).unwrap();
+    // A preset's name, or a vessel file.
+    let vessel = if name.ends_with(".toml") {
+        Vessel::from_toml_str(&std::fs::read_to_string(name).unwrap()).unwrap()
+    } else {
+        Vessel::preset(name).unwrap()
+    };
     let mut y0 = vessel.initial_state();
     y0.p += Vector3::new(1e5, 2e4, 0.0);
     y0.m += Vector3::new(1e5, -1e5, 3e5);

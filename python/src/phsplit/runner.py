@@ -117,7 +117,7 @@ def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, ort
         raw["supplied"], raw["dissipated"], controls=tuple(raw["control_accounts"]),
         status=raw["status"], method=info["name"], h=used["h"], control_start=used["control_start"],
         steps=raw["steps"], failure=raw.get("failure"), last_good_state=raw["last_good"],
-        meta={"mass": mass, "inertia": inertia, "mass_matrix": vessel.mass_matrix,
+        meta={"mass": mass, "inertia": inertia, "mass_matrix": vessel.mass_matrix, "s2_solver": raw["s2_solver"],
               "t_last_good": raw["t_last_good"], "components": vessel.components},
         settings=dict(used),
         outputs={k: (u, ln, np.asarray(v)) for k, (u, ln, v) in raw.get("outputs", {}).items()},

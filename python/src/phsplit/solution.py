@@ -273,6 +273,10 @@ class Solution:
         if "chunks" in prov:
             ds.attrs["phsplit_chunks"] = " ".join(str(int(c)) for c in prov["chunks"])
         ds.attrs["software"] = cf.software_versions()
+        if "s2_solver" in self.meta:
+            # How flow S2 was integrated: the linear flow asked for, or Gauss collocation where S2
+            # has a forcing part (runner.SettingWarning).
+            ds.attrs["s2_solver"] = str(self.meta["s2_solver"])
         if self.failure:
             ds.attrs["failure"] = self.failure
         return ds

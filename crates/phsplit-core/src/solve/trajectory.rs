@@ -134,6 +134,7 @@ impl<'m, M: Model> Recorder<'m, M> {
         if n == 0 {
             return;
         }
+        self.probed.clear();
         self.probed.resize(n, 0.0);
         self.model.probe(t, y, &mut self.probed);
         let v = &self.probed;

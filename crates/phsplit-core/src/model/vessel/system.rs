@@ -359,7 +359,7 @@ impl<'a> VesselSystem<'a> {
         Work::from_fn(self.accounts.len(), |k| {
             let mut p = 0.0;
             for sys in 0..2 {
-                p += nu[sys].dot(&booked[k][sys].at(&nu, &z[sys]));
+                p += nu[sys].dot(&booked[k][sys].at(&nu, z, sys));
             }
             self.sign(k) * p
         })

@@ -45,6 +45,7 @@ pub mod external;
 pub mod pid;
 pub mod pipe;
 pub mod restoring;
+pub mod spring;
 pub mod thrusters;
 pub mod waves;
 pub mod wind;
@@ -68,6 +69,7 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("external", &["external"], external::build),
     ("current", &["current"], current::build),
     ("pipe", &["pipe"], pipe::build),
+    ("spring", &["spring"], spring::build),
     ("waves", &["waves"], waves::build),
     ("wind", &["wind"], wind::build),
 ];
@@ -81,8 +83,11 @@ pub enum Sys {
 }
 
 /// A generalised force on the momentum `u` of one block system, affine in the body velocities
-/// `ν = (v_t, ω) = M⁻¹u` and in the system's other states `(v, w)`:
-/// `f = F_t v_t + F_r ω + fv v + fw w + c` (body frame; N or N m), with `fnu = [F_t, F_r]`.
+/// `ν = (v_t, ω) = M⁻¹u`, in the system's other states `(v, w)` and in the other system's second
+/// state `v'`: `f = F_t v_t + F_r ω + fv v + fw w + fv_other v' + c` (body frame; N or N m), with
+/// `fnu = [F_t, F_r]`. `fv_other` couples the systems (a moment from the position, as a spring at
+/// a point of the hull gives: `spring.rs`); the rows stay in the exact or collocated linear flow
+/// S2, and a booked force's power is exact along it like any other row.
 /// A force written on the velocities holds for any mass matrix: the system turns it into rows
 /// on the momenta (and, where `M` or the force couples translation and rotation, into one
 /// coupled system).
@@ -91,6 +96,9 @@ pub struct Rows {
     pub fnu: [Matrix3<f64>; 2],
     pub fv: Matrix3<f64>,
     pub fw: Matrix3<f64>,
+    /// The force per the other block system's second state (translation: `x − x_o`; rotation:
+    /// `mu`).
+    pub fv_other: Matrix3<f64>,
     pub c: Vector3<f64>,
 }
 
@@ -102,6 +110,7 @@ impl Rows {
         ],
         fv: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
         fw: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+        fv_other: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
         c: Vector3::new(0.0, 0.0, 0.0),
     };
     /// A constant force.
@@ -114,15 +123,23 @@ impl Rows {
         r.fnu[of as usize] = f;
         r
     }
-    /// The force at the velocities `nu` and the block state `z` of its system.
-    pub fn at(&self, nu: &[Vector3<f64>; 2], z: &[Vector3<f64>; 3]) -> Vector3<f64> {
-        self.fnu[0] * nu[0] + self.fnu[1] * nu[1] + self.fv * z[1] + self.fw * z[2] + self.c
+    /// The force on system `sys` at the velocities `nu` and the block states `z` of both systems.
+    #[inline]
+    pub fn at(&self, nu: &[Vector3<f64>; 2], z: &[Z3; 2], sys: usize) -> Vector3<f64> {
+        let own = &z[sys];
+        self.fnu[0] * nu[0]
+            + self.fnu[1] * nu[1]
+            + self.fv * own[1]
+            + self.fw * own[2]
+            + self.fv_other * z[1 - sys][1]
+            + self.c
     }
     fn add(&mut self, o: &Rows) {
         self.fnu[0] += o.fnu[0];
         self.fnu[1] += o.fnu[1];
         self.fv += o.fv;
         self.fw += o.fw;
+        self.fv_other += o.fv_other;
         self.c += o.c;
     }
 }
@@ -253,6 +270,7 @@ impl S2Builder {
         b.auv += f.fv;
         b.auw += f.fw;
         b.cu += f.c;
+        self.other_v[k] += f.fv_other;
         if let (Some(a), Some(book)) = (account, self.booked.as_mut()) {
             book[self.base + a][k].add(f);
         }

@@ -42,8 +42,8 @@ impl VesselSystem<'_> {
         (0..self.accounts.len())
             .map(|k| {
                 (
-                    booked[k][0].at(&nu, &z[0]) + g.booked(k)[0],
-                    booked[k][1].at(&nu, &z[1]) + g.booked(k)[1],
+                    booked[k][0].at(&nu, &z, 0) + g.booked(k)[0],
+                    booked[k][1].at(&nu, &z, 1) + g.booked(k)[1],
                 )
             })
             .collect()
@@ -72,8 +72,8 @@ impl VesselSystem<'_> {
                 for (i, a) in f.accounts().iter().enumerate() {
                     if a.role == Role::Control {
                         let k = base + i;
-                        force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked(k)[0];
-                        moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked(k)[1];
+                        force += booked[k][0].at(&fr.velocity, &z, 0) + g.booked(k)[0];
+                        moment += booked[k][1].at(&fr.velocity, &z, 1) + g.booked(k)[1];
                     }
                 }
             }

@@ -360,6 +360,8 @@ fn power_weights(
 /// The energy a force with rows `f` books over the sub-step, `Σ [F_k | F_v | F_w | c] ∘ W`
 /// with the weights of [`power_weights`].
 fn energy(f: &Rows, w: &SMatrix<f64, 3, 10>, k: usize) -> f64 {
+    // Rows on the other system's state couple the systems: they take the coupled flow.
+    debug_assert!(f.fv_other.iter().all(|x| *x == 0.0));
     f.fnu[k].component_mul(&w.fixed_view::<3, 3>(0, 0)).sum()
         + f.fv.component_mul(&w.fixed_view::<3, 3>(0, 3)).sum()
         + f.fw.component_mul(&w.fixed_view::<3, 3>(0, 6)).sum()

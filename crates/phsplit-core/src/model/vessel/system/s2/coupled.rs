@@ -196,6 +196,8 @@ impl VesselSystem<'_> {
             fv += f.fv;
             let mut fw = rk.fixed_view_mut::<3, 3>(0, 9 * k + 6);
             fw += f.fw;
+            let mut fo = rk.fixed_view_mut::<3, 3>(0, 9 * (1 - k) + 3);
+            fo += f.fv_other;
             let mut c = rk.fixed_view_mut::<3, 1>(0, 18);
             c += f.c;
             r.fixed_view_mut::<3, 19>(3 * k, 0).copy_from(&rk);
@@ -319,10 +321,13 @@ impl VesselSystem<'_> {
                 self.add_forcing_of(fr, t + nodes[i] * h, z0, Some(false), &mut fixed[i]);
             }
         }
+        // `g[i].g` is the whole stage forcing (the fixed part's field, then the state's parts
+        // added to it, in the order of the sum written out); `g[i]` books the state's parts only,
+        // `fixed[i]` the rest.
         let mut g: [Forcing; 3] = std::array::from_fn(|_| Forcing::new());
-        let total = |f: &Forcing, g: &Forcing| -> [Z3; 2] {
-            std::array::from_fn(|k| std::array::from_fn(|c| f.g[k][c] + g.g[k][c]))
-        };
+        for i in 0..s {
+            g[i].g = fixed[i].g;
+        }
         let mut gt = [[SVector::<f64, 6>::zeros(); 3]; 3];
         let mut stage_z = [*z0; 3];
         let mut ys: [Six; 3] = [zb0; 3];
@@ -337,6 +342,7 @@ impl VesselSystem<'_> {
                 for i in 0..s {
                     if stateful {
                         g[i].clear();
+                        g[i].g = fixed[i].g;
                         self.add_forcing_of(
                             fr,
                             t + nodes[i] * h,
@@ -345,7 +351,7 @@ impl VesselSystem<'_> {
                             &mut g[i],
                         );
                     }
-                    gt[i] = mul6(&to_six(&total(&fixed[i], &g[i])), &inv);
+                    gt[i] = mul6(&to_six(&g[i].g), &inv);
                 }
                 // After an unrelaxed pass the stages solve the linear stage equations with the
                 // previous forcing, so the residual of the collocation equations at them is
@@ -411,8 +417,9 @@ impl VesselSystem<'_> {
             // field and the forcing at them.
             for i in 0..s {
                 g[i].clear();
+                g[i].g = fixed[i].g;
                 self.add_forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true), &mut g[i]);
-                gt[i] = mul6(&to_six(&total(&fixed[i], &g[i])), &inv);
+                gt[i] = mul6(&to_six(&g[i].g), &inv);
                 y1 = axpy(&y1, &axpy(&field(&ys[i]), &gt[i], 1.0), h * bw[i]);
             }
         } else {
