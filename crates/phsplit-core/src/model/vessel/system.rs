@@ -11,7 +11,7 @@
 //! components' outputs, each account's wrench, the controller's wrench for the probe) is
 //! `system/report.rs`.
 
-use super::forces::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
+use super::forces::{Force, Forcing, Frozen, S2Builder, Sys};
 use super::state::{Actuators, VesselState};
 use super::Vessel;
 use crate::error::{Error, Result};
@@ -354,15 +354,21 @@ impl<'a> VesselSystem<'a> {
     }
 
     /// Power per account at block states `z`, from the booked rows: `±(M⁻¹u)·f`.
-    fn power_at(&self, booked: &[[Rows; 2]], z: &[Z3; 2]) -> Work {
+    fn power_at(&self, b: &S2Builder, z: &[Z3; 2]) -> Work {
+        let booked = b.booked.as_deref().expect("assembled with the ledger");
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
-        Work::from_fn(self.accounts.len(), |k| {
+        let mut w = Work::from_fn(self.accounts.len(), |k| {
             let mut p = 0.0;
             for sys in 0..2 {
-                p += nu[sys].dot(&booked[k][sys].at(&nu, z, sys));
+                p += nu[sys].dot(&booked[k][sys].at(&nu, &z[sys]));
             }
             self.sign(k) * p
-        })
+        });
+        for (a, sys, r) in &b.cross_booked {
+            let k = *sys as usize;
+            w.add(*a, self.sign(*a) * nu[k].dot(&(r * z[1 - k][1])));
+        }
+        w
     }
 
     /// The vector field of flow S1 (eq. 40) or S2 (eq. 41) at `s` and time `t`. Their sum is
@@ -432,7 +438,7 @@ impl<'a> VesselSystem<'a> {
         let fr = self.frozen(s, on);
         let b = self.s2_of(&fr, true);
         let z = self.blocks_of(s);
-        let mut w = self.power_at(b.booked.as_ref().expect("built with the ledger"), &z);
+        let mut w = self.power_at(&b, &z);
         if self.forced {
             let g = self.forcing(&fr, t, &z);
             w += self.forcing_power(&[&g], &z);

@@ -83,11 +83,9 @@ pub enum Sys {
 }
 
 /// A generalised force on the momentum `u` of one block system, affine in the body velocities
-/// `ν = (v_t, ω) = M⁻¹u`, in the system's other states `(v, w)` and in the other system's second
-/// state `v'`: `f = F_t v_t + F_r ω + fv v + fw w + fv_other v' + c` (body frame; N or N m), with
-/// `fnu = [F_t, F_r]`. `fv_other` couples the systems (a moment from the position, as a spring at
-/// a point of the hull gives: `spring.rs`); the rows stay in the exact or collocated linear flow
-/// S2, and a booked force's power is exact along it like any other row.
+/// `ν = (v_t, ω) = M⁻¹u` and in the system's other states `(v, w)`:
+/// `f = F_t v_t + F_r ω + fv v + fw w + c` (body frame; N or N m), with `fnu = [F_t, F_r]`.
+/// (A force on the other system's second state is added by [`S2Builder::force_from_other_v`].)
 /// A force written on the velocities holds for any mass matrix: the system turns it into rows
 /// on the momenta (and, where `M` or the force couples translation and rotation, into one
 /// coupled system).
@@ -96,9 +94,6 @@ pub struct Rows {
     pub fnu: [Matrix3<f64>; 2],
     pub fv: Matrix3<f64>,
     pub fw: Matrix3<f64>,
-    /// The force per the other block system's second state (translation: `x − x_o`; rotation:
-    /// `mu`).
-    pub fv_other: Matrix3<f64>,
     pub c: Vector3<f64>,
 }
 
@@ -110,7 +105,6 @@ impl Rows {
         ],
         fv: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
         fw: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-        fv_other: Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
         c: Vector3::new(0.0, 0.0, 0.0),
     };
     /// A constant force.
@@ -123,23 +117,15 @@ impl Rows {
         r.fnu[of as usize] = f;
         r
     }
-    /// The force on system `sys` at the velocities `nu` and the block states `z` of both systems.
-    #[inline]
-    pub fn at(&self, nu: &[Vector3<f64>; 2], z: &[Z3; 2], sys: usize) -> Vector3<f64> {
-        let own = &z[sys];
-        self.fnu[0] * nu[0]
-            + self.fnu[1] * nu[1]
-            + self.fv * own[1]
-            + self.fw * own[2]
-            + self.fv_other * z[1 - sys][1]
-            + self.c
+    /// The force at the velocities `nu` and the block state `z` of its system.
+    pub fn at(&self, nu: &[Vector3<f64>; 2], z: &[Vector3<f64>; 3]) -> Vector3<f64> {
+        self.fnu[0] * nu[0] + self.fnu[1] * nu[1] + self.fv * z[1] + self.fw * z[2] + self.c
     }
     fn add(&mut self, o: &Rows) {
         self.fnu[0] += o.fnu[0];
         self.fnu[1] += o.fnu[1];
         self.fv += o.fv;
         self.fw += o.fw;
-        self.fv_other += o.fv_other;
         self.c += o.c;
     }
 }
@@ -201,6 +187,10 @@ pub struct S2Builder {
     pub cross: Option<[[Matrix3<f64>; 3]; 2]>,
     /// Force rows per account and system (only with the ledger: one per account of the run).
     pub booked: Option<Vec<[Rows; 2]>>,
+    /// Booked forces on one system's momentum per the other system's second state, `F v_l`
+    /// (with the ledger): the account, the system acted on, `F`. Few or none (a spring at a
+    /// point of the hull), so kept apart from [`Rows`] and its every account's products.
+    pub cross_booked: Vec<(usize, Sys, Matrix3<f64>)>,
     /// First account of the component being assembled.
     pub(crate) base: usize,
     /// The ledger rows' allocation while the builder has no ledger ([`Self::reset`]).
@@ -226,6 +216,7 @@ impl S2Builder {
             other_v: [Matrix3::zeros(); 2],
             cross: None,
             booked: accounts.map(|n| vec![[Rows::ZERO; 2]; n]),
+            cross_booked: Vec::new(),
             base: 0,
             spare: None,
         }
@@ -247,6 +238,7 @@ impl S2Builder {
             m.fill(0.0);
         }
         self.cross = None;
+        self.cross_booked.clear();
         self.base = 0;
         // The rows' allocation is kept aside while the builder has no ledger.
         let mut v = self.booked.take().or(self.spare.take()).unwrap_or_default();
@@ -270,7 +262,6 @@ impl S2Builder {
         b.auv += f.fv;
         b.auw += f.fw;
         b.cu += f.c;
-        self.other_v[k] += f.fv_other;
         if let (Some(a), Some(book)) = (account, self.booked.as_mut()) {
             book[self.base + a][k].add(f);
         }
@@ -281,10 +272,24 @@ impl S2Builder {
         self.nu_v[sys as usize][of as usize] += r;
     }
     /// Add a force `r v_l` on the momentum of `sys` from the second state `v_l` of the other
-    /// system, booked to no account (a conservative exchange between stores of H: the
-    /// restoring's heave–pitch coupling).
-    pub fn force_from_other_v(&mut self, sys: Sys, r: &Matrix3<f64>) {
+    /// system (translation: `x − x_o`; rotation: `mu`), booked to the component's account
+    /// `account`, or to none (`None`: a conservative exchange between stores of H, like the
+    /// restoring's heave–pitch coupling). It couples the systems: flow S2 is then one coupled
+    /// affine system, exact or collocated, and a booked force's power is exact along it like any
+    /// row's (the spring's moment from the position, `spring.rs`).
+    pub fn force_from_other_v(&mut self, sys: Sys, account: Option<usize>, r: &Matrix3<f64>) {
         self.other_v[sys as usize] += r;
+        if let (Some(a), Some(_)) = (account, self.booked.as_ref()) {
+            self.cross_booked.push((self.base + a, sys, *r));
+        }
+    }
+    /// The booked forces on the other system's second state at the block states `z`, added to
+    /// each account's force `f[account][system]`.
+    pub fn add_cross_booked(&self, z: &[Z3; 2], f: &mut [[Vector3<f64>; 2]]) {
+        for (a, sys, r) in &self.cross_booked {
+            let k = *sys as usize;
+            f[*a][k] += r * z[1 - k][1];
+        }
     }
     /// The block system `sys`, to add the rows of the integral states a component drives
     /// (`w' = A_wv v + c_w`).

@@ -294,7 +294,6 @@ impl Pid {
             fnu: [a.fnu[0] + b.fnu[0], a.fnu[1] + b.fnu[1]],
             fv: a.fv + b.fv,
             fw: a.fw + b.fw,
-            fv_other: a.fv_other + b.fv_other,
             c: a.c + b.c,
         };
         (
@@ -351,8 +350,8 @@ impl Pid {
         nu: &[Vector3<f64>; 2],
         z: &[Z3; 2],
     ) -> (Vector3<f64>, Vector3<f64>) {
-        let mut f = r.port[0].at(nu, z, 0) + r.damping[0].at(nu, z, 0);
-        let mut m = r.port[1].at(nu, z, 1) + r.damping[1].at(nu, z, 1);
+        let mut f = r.port[0].at(nu, &z[0]) + r.damping[0].at(nu, &z[0]);
+        let mut m = r.port[1].at(nu, &z[1]) + r.damping[1].at(nu, &z[1]);
         if let Some(mv) = mv {
             f += mv.force;
             m += mv.moment;
@@ -509,8 +508,8 @@ impl Force for Pid {
                 };
                 // What the thrusters deliver, less the affine part already in flow S2.
                 let (rt, rr) = Self::allocated_rows(&r);
-                g.force(Sys::Trans, Some(0), force - rt.at(&nu, z, 0));
-                g.force(Sys::Rot, Some(0), moment - rr.at(&nu, z, 1));
+                g.force(Sys::Trans, Some(0), force - rt.at(&nu, &z[0]));
+                g.force(Sys::Rot, Some(0), moment - rr.at(&nu, &z[1]));
             }
         }
     }

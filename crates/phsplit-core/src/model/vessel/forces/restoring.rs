@@ -135,7 +135,7 @@ impl Force for Restoring {
         if self.coupling != Vector3::zeros() {
             // The heave force's part −q3 (c r_F)ᵀ G'⁺ mu, and mu' = … + c r_F q3ᵀ v.
             let lever = self.g_plus * self.coupling;
-            b.force_from_other_v(Sys::Trans, &(fr.q3 * lever.transpose() * -1.0));
+            b.force_from_other_v(Sys::Trans, None, &(fr.q3 * lever.transpose() * -1.0));
             b.rate_v(Sys::Rot, Sys::Trans, &(self.coupling * fr.q3.transpose()));
         }
     }

@@ -9,7 +9,7 @@
 //!
 //! At frozen attitude (flow S2, paper eq. 41) both are affine in the translational block's
 //! position `x − x_o`: the force as rows on the translation's own second state, the moment as
-//! rows on the other system's (`Rows::fv_other`), a coupling of translation and rotation. They
+//! rows on the other system's (`S2Builder::force_from_other_v`, booked), a coupling of translation and rotation. They
 //! stay in the linear flow S2, exact or collocated, with no forcing: the spring's work on the
 //! hull `v·f_b + ω·m_b` is booked as the port `spring` (supplied), exactly along the exact flow
 //! (the Gramian) and by Gauss quadrature along the collocated one.
@@ -97,15 +97,8 @@ impl Force for Spring {
         );
         // m_b = r × f_b: on the translation's position, a row of the other system.
         let r = so3::hat(&self.fairlead);
-        b.force(
-            Sys::Rot,
-            Some(0),
-            &Rows {
-                fv_other: r * fv,
-                c: r * c,
-                ..Rows::ZERO
-            },
-        );
+        b.force(Sys::Rot, Some(0), &Rows::constant(r * c));
+        b.force_from_other_v(Sys::Rot, Some(0), &(r * fv));
     }
     fn outputs(&self, fr: &Frozen, _z: &[Z3; 2], s: &VesselState, _t: f64, out: &mut Vec<Output>) {
         out.push(Output::new(

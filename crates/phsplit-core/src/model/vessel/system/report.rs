@@ -1,7 +1,7 @@
 //! What the vessel reports at a state, for the results and the probe: the components'
 //! outputs, the force and moment of each ledger account, and the controller's wrench.
 
-use super::super::forces::{Force, Forcing, Frozen, Output, Rows, S2Builder};
+use super::super::forces::{Force, Forcing, Frozen, Output, S2Builder, Sys};
 use super::super::state::VesselState;
 use super::VesselSystem;
 use crate::solve::Role;
@@ -35,18 +35,20 @@ impl VesselSystem<'_> {
     ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
         let fr = self.frozen(s, on);
         let b = self.s2_of(&fr, true);
-        let booked = b.booked.expect("built with the ledger");
+        let booked = b.booked.as_deref().expect("built with the ledger");
         let z = self.blocks_of(s);
         let nu = self.vessel.body.velocity(&s.p, &s.m);
         let g = self.forcing(&fr, t, &z);
-        (0..self.accounts.len())
+        let mut f: Vec<[Vector3<f64>; 2]> = (0..self.accounts.len())
             .map(|k| {
-                (
-                    booked[k][0].at(&nu, &z, 0) + g.booked(k)[0],
-                    booked[k][1].at(&nu, &z, 1) + g.booked(k)[1],
-                )
+                [
+                    booked[k][0].at(&nu, &z[0]) + g.booked(k)[0],
+                    booked[k][1].at(&nu, &z[1]) + g.booked(k)[1],
+                ]
             })
-            .collect()
+            .collect();
+        b.add_cross_booked(&z, &mut f);
+        f.into_iter().map(|[f, m]| (f, m)).collect()
     }
 
     /// The controller's force and moment (body frame, about the body origin) at `s` on a step
@@ -58,7 +60,8 @@ impl VesselSystem<'_> {
     pub(super) fn control_wrench(&self, s: &VesselState, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let on = self.control_on(t);
         let z = self.blocks_of(s);
-        let wrench = |fr: &Frozen, booked: &[[Rows; 2]]| {
+        let wrench = |fr: &Frozen, b: &S2Builder| {
+            let booked = b.booked.as_deref().expect("assembled with the ledger");
             let mut g = Forcing::new();
             let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
             for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
@@ -72,17 +75,24 @@ impl VesselSystem<'_> {
                 for (i, a) in f.accounts().iter().enumerate() {
                     if a.role == Role::Control {
                         let k = base + i;
-                        force += booked[k][0].at(&fr.velocity, &z, 0) + g.booked(k)[0];
-                        moment += booked[k][1].at(&fr.velocity, &z, 1) + g.booked(k)[1];
+                        force += booked[k][0].at(&fr.velocity, &z[0]) + g.booked(k)[0];
+                        moment += booked[k][1].at(&fr.velocity, &z[1]) + g.booked(k)[1];
+                    }
+                }
+            }
+            for (k, sys, r) in &b.cross_booked {
+                if self.accounts[*k].role == Role::Control {
+                    let f = r * z[1 - *sys as usize][1];
+                    match sys {
+                        Sys::Trans => force += f,
+                        Sys::Rot => moment += f,
                     }
                 }
             }
             (force, moment)
         };
         if self.probe_assembles_whole() {
-            return self.with_s2(s, on, true, true, |fr, b| {
-                wrench(fr, b.booked.as_deref().expect("assembled with the ledger"))
-            });
+            return self.with_s2(s, on, true, true, |fr, b| wrench(fr, b));
         }
         let fr = self.frozen(s, on);
         let mut b = S2Builder::new(Some(self.accounts.len()));
@@ -92,6 +102,6 @@ impl VesselSystem<'_> {
                 f.add_s2(&fr, &mut b);
             }
         }
-        wrench(&fr, &b.booked.expect("built with the ledger"))
+        wrench(&fr, &b)
     }
 }

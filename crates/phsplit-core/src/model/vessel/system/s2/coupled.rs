@@ -179,7 +179,7 @@ impl VesselSystem<'_> {
     /// An account's power `Σ_k ν_kᵀ f_k = Σ R ∘ (z̄_U z̄ᵀ)` as rows `R` on the momentum entries
     /// `U` ([`MOMENTA`]) of `z̄`, with `ν = M⁻¹u` through the full `M⁻¹`. Its integral along S2 is
     /// `Σ R ∘ Y` with `Y` the rows `U` of the Gramian.
-    fn power_rows_full(&self, rows: &[Rows; 2]) -> SMatrix<f64, 6, 19> {
+    fn power_rows_full(&self, rows: &[Rows; 2], acc: usize, b: &S2Builder) -> SMatrix<f64, 6, 19> {
         let mi = &self.vessel.body.minv_blocks;
         // ν = E z̄ = E_U z̄_U.
         let mut e = SMatrix::<f64, 6, 19>::zeros();
@@ -196,11 +196,17 @@ impl VesselSystem<'_> {
             fv += f.fv;
             let mut fw = rk.fixed_view_mut::<3, 3>(0, 9 * k + 6);
             fw += f.fw;
-            let mut fo = rk.fixed_view_mut::<3, 3>(0, 9 * (1 - k) + 3);
-            fo += f.fv_other;
             let mut c = rk.fixed_view_mut::<3, 1>(0, 18);
             c += f.c;
             r.fixed_view_mut::<3, 19>(3 * k, 0).copy_from(&rk);
+        }
+        // The account's forces on the other system's second state.
+        for (a, sys, f) in &b.cross_booked {
+            if *a == acc {
+                let k = *sys as usize;
+                let mut fo = r.fixed_view_mut::<3, 3>(3 * k, 9 * (1 - k) + 3);
+                fo += f;
+            }
         }
         let e_u = SMatrix::<f64, 6, 6>::from_fn(|i, j| e[(i, MOMENTA[j])]);
         e_u.transpose() * r
@@ -256,7 +262,7 @@ impl VesselSystem<'_> {
                 let (zb1, gram) =
                     affine::flow_action_and_gramian_rows::<19, 6, 38>(&a, &zb0, h, &MOMENTA);
                 for acc in 0..self.accounts.len() {
-                    let r = self.power_rows_full(&booked[acc]);
+                    let r = self.power_rows_full(&booked[acc], acc, b);
                     let energy = (0..19)
                         .map(|j| {
                             (0..6)
@@ -433,9 +439,9 @@ impl VesselSystem<'_> {
         }
         let z1 = from_six(&mul6(&y1, &sc));
         let mut work = Work::default();
-        if let Some(booked) = &b.booked {
+        if b.booked.is_some() {
             for i in 0..s {
-                let mut p = self.power_at(booked, &stage_z[i]);
+                let mut p = self.power_at(b, &stage_z[i]);
                 if forced {
                     p += self.forcing_power(&[&fixed[i], &g[i]], &stage_z[i]);
                 }
