@@ -49,6 +49,23 @@ pub struct Instance {
     pub stop_time: Option<f64>,
     pub time: f64,
     running: Option<Running>,
+    /// The accounts' wrenches and the components' outputs at the current state, computed for
+    /// the first output read and reused by the others until time, state or vessel change.
+    reports: Reports,
+}
+
+/// What the outputs are read from at one state: the key (time, vessel, state, bit for bit),
+/// each account's force and moment, and each component output's value.
+type Report = (Vec<u64>, Vec<(Vector3<f64>, Vector3<f64>)>, Vec<f64>);
+
+/// The kept [`Report`]; a copy of an instance (its saved state) starts without one.
+#[derive(Debug, Default)]
+struct Reports(std::sync::Mutex<Option<Report>>);
+
+impl Clone for Reports {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 /// The components the inputs act through, and the tables they read.
@@ -76,6 +93,7 @@ impl Instance {
             stop_time: None,
             time: 0.0,
             running: None,
+            reports: Reports::default(),
         }
     }
 
@@ -417,16 +435,15 @@ impl Instance {
                 account,
                 moment,
                 axis,
-            } => {
-                let (sys, r) = self.system()?;
-                let w = sys.account_wrenches(&r.state, self.time, sys.control_on(self.time));
+            } => self.report(|(_, w, _)| {
                 let (f, m) = w[*account];
-                Ok(if *moment { m[*axis] } else { f[*axis] })
-            }
-            Role::ComponentOutput(i) => {
-                let (sys, r) = self.system()?;
-                Ok(sys.outputs(&r.state, self.time)[*i].value)
-            }
+                if *moment {
+                    m[*axis]
+                } else {
+                    f[*axis]
+                }
+            }),
+            Role::ComponentOutput(i) => self.report(|(_, _, o)| o[*i]),
             _ => match &self.values[vr as usize] {
                 Some(Val::Real(x)) => Ok(*x),
                 _ => Err(format!("{} has no value", v.name)),
@@ -450,13 +467,30 @@ impl Instance {
         }
     }
 
-    /// The running vessel's system (its outputs are defined once the FMU is initialised).
-    fn system(&self) -> Result<(VesselSystem<'_>, &Running)> {
+    /// `read` of the accounts' wrenches and the components' outputs at the current state, the
+    /// time and the controller's switch there, computed once per state.
+    fn report(&self, read: impl FnOnce(&Report) -> f64) -> Result<f64> {
         let r = self
             .running
             .as_ref()
             .ok_or("outputs are defined once the FMU is initialised")?;
-        Ok((VesselSystem::new(&r.vessel, r.settings.control_start), r))
+        let mut key = vec![self.time.to_bits(), Arc::as_ptr(&r.vessel) as usize as u64];
+        key.extend(r.state.to_vector().iter().map(|v| v.to_bits()));
+        let act = &r.state.act;
+        key.extend([act.n as u64, act.t.to_bits()]);
+        key.extend(act.thrust.iter().chain(&act.angle).map(|v| v.to_bits()));
+        let mut kept = self.reports.0.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.as_ref().is_none_or(|k| k.0 != key) {
+            let sys = VesselSystem::new(&r.vessel, r.settings.control_start);
+            let wrenches = sys.account_wrenches(&r.state, self.time, sys.control_on(self.time));
+            let outputs = sys
+                .outputs(&r.state, self.time)
+                .into_iter()
+                .map(|o| o.value)
+                .collect();
+            *kept = Some((key, wrenches, outputs));
+        }
+        Ok(read(kept.as_ref().expect("kept above")))
     }
 
     fn output(&self, group: &str, i: usize) -> Result<f64> {
