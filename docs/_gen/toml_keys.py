@@ -64,6 +64,10 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "velocity": ("m/s", "[0, 0, 0]", "uniform current, spatial frame, towards; each component within ±10 m/s (§5.5)"),
         "times": ("s", "none", "instead of `velocity`: increasing times of a current table"),
         "velocities": ("m/s", "none", "one row of 3 numbers per time; linear in between, constant outside"),
+        "speed": ("m/s", "none", "instead of `velocity`: the current's speed, 0 to 10, with one direction key"),
+        "direction": ("degrees", "none", "with `speed`: where the water flows towards, spatial, from x towards y"),
+        "direction_towards": ("degrees", "none", "the same as `direction`"),
+        "direction_from": ("degrees", "none", "with `speed`, instead: where the water comes from"),
     },
     "damping_quadratic": {
         "coefficients": ("kg/m (surge, sway, heave), kg m² (roll, pitch, yaw)", REQ,

@@ -70,7 +70,8 @@ def test_the_ledger_books_the_current_as_a_port_and_closes():
 def test_bad_current_tables():
     base = phsplit.Vessel.paper().to_dict()
     for table, words in (({"velocity": [1.0, 2.0]}, "3 numbers"), ({"velocity": [0.0, float("nan"), 0.0]}, "finite"),
-                         ({"velocity": [12.0, 0.0, 0.0]}, "10 m/s"), ({"speed": 1.0}, r"unknown field `speed` in \[current\] \(allowed: times, velocities, velocity\)")):
+                         ({"velocity": [12.0, 0.0, 0.0]}, "10 m/s"), ({"speed": 1.0}, r"current.speed needs exactly one of current.direction"),
+                         ({"sped": 1.0}, r"unknown field `sped` in \[current\]")):
         d = dict(base, current=table)
         with pytest.raises(phsplit.InvalidInputError, match=words):
             phsplit.Vessel.from_dict(d)
@@ -123,3 +124,33 @@ def test_bad_current_time_tables():
                          ({"times": [0.0], "velocities": [[1.0, 0, 0]], "velocity": [1.0, 0, 0]}, "not both")):
         with pytest.raises(phsplit.InvalidInputError, match=words):
             phsplit.Vessel.from_dict(dict(base, current=table))
+
+
+def test_a_vessel_files_current_by_speed_and_direction_in_either_convention():
+    """[current] speed with direction / direction_towards (where it flows) or direction_from
+    (where it comes from), degrees from x towards y: the velocity written out, recorded as
+    `velocity` in the normalised file (which reads back the same); the two conventions half a
+    turn apart; bad combinations refused naming the keys."""
+    import math
+
+    def current(table):
+        d = phsplit.Vessel.paper().to_dict()
+        d["current"] = table
+        return phsplit.Vessel.from_dict(d)
+
+    want = [0.5 * math.cos(math.radians(190.0)), 0.5 * math.sin(math.radians(190.0)), 0.0]
+    for table in ({"speed": 0.5, "direction": 190.0}, {"speed": 0.5, "direction_towards": 190.0},
+                  {"speed": 0.5, "direction_from": 10.0}):
+        v = current(table)
+        got = v.to_dict()["current"]
+        assert set(got) == {"velocity"}
+        assert np.allclose(got["velocity"], want, rtol=0, atol=1e-15), (table, got)
+        assert phsplit.Vessel.from_toml_str(v.to_toml()).to_dict()["current"] == got
+    for table, words in [({"speed": 0.5}, "exactly one of current.direction"),
+                         ({"direction": 3.0}, "current.direction gives the direction of current.speed"),
+                         ({"speed": 0.5, "direction": 1.0, "direction_from": 2.0}, "got direction and direction_from"),
+                         ({"speed": -1.0, "direction": 0.0}, "current.speed must be within 0 to 10 m/s"),
+                         ({"speed": 0.5, "direction": 0.0, "velocity": [0.1, 0.0, 0.0]}, "either velocity"),
+                         ({"speed": 0.5, "direction": 1000.0}, "within ±360 degrees")]:
+        with pytest.raises(phsplit.InvalidInputError, match=words):
+            current(table)

@@ -1,7 +1,10 @@
 //! A constant, uniform ocean current (docs/model.md §5.5).
 //!
 //! Table `[current]` (optional): `velocity` (m/s, spatial frame, z up; the direction the water
-//! flows towards), each component within ±10 m/s. The hydrodynamic damping then acts on the
+//! flows towards), each component within ±10 m/s; or instead `speed` (m/s, within 0–10) with one
+//! of `direction` or `direction_towards` (degrees, spatial, from x towards y: where the water
+//! flows towards) or `direction_from` (where it comes from), written to the normalised file as
+//! the `velocity` they give. The hydrodynamic damping then acts on the
 //! velocity relative to the water, `−D_t (v − v_c)` with `v_c = Qᵀ V_c` in the body frame
 //! (T. I. Fossen, "How to incorporate wind, waves and ocean currents in the marine craft
 //! equations of motion", IFAC MCMC 2012: relative velocity in the damping; for a vessel without
@@ -59,6 +62,77 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
     Ok(read(p, body)?.map(|c| Arc::new(c) as Arc<dyn Force>))
 }
 
+/// The keys that give a constant current's direction by its speed (degrees, spatial, from x
+/// towards y): where it flows towards (`direction`, `direction_towards`; the oceanographic
+/// convention) or where it comes from (`direction_from`).
+const DIRECTION_KEYS: [&str; 3] = ["direction", "direction_towards", "direction_from"];
+
+/// A constant current given by `speed` (m/s, `0..=MAX_SPEED`) and one of [`DIRECTION_KEYS`]
+/// instead of `velocity`: its velocity, recorded as `velocity` in the normalised file (so the
+/// file reads back the same), or `None` without `speed`.
+fn speed_and_direction(p: &mut Params) -> crate::Result<Option<[f64; 3]>> {
+    const T: &str = "current";
+    let number = |key: &str, v: &toml::Value, unit: &str| match v {
+        toml::Value::Float(f) => Ok(*f),
+        toml::Value::Integer(i) => Ok(*i as f64),
+        other => Err(Error::Parse(format!(
+            "current.{key} must be a number ({unit}), got {} {other}",
+            other.type_str()
+        ))),
+    };
+    let Some(raw) = p.take_raw(T, "speed")? else {
+        for key in DIRECTION_KEYS {
+            if p.take_raw(T, key)?.is_some() {
+                return Err(Error::InvalidInput(format!(
+                    "current.{key} gives the direction of current.speed (m/s), which is missing; or give current.velocity (m/s, spatial frame) alone"
+                )));
+            }
+        }
+        return Ok(None);
+    };
+    let speed = number("speed", &raw, "m/s")?;
+    if !(0.0..=MAX_SPEED).contains(&speed) {
+        return Err(Error::InvalidInput(format!(
+            "current.speed must be within 0 to {MAX_SPEED} m/s, got {speed}"
+        )));
+    }
+    if p.take_raw(T, "velocity")?.is_some() {
+        return Err(Error::InvalidInput(
+            "[current] takes either velocity (m/s, spatial frame) or speed with a direction, not both".into(),
+        ));
+    }
+    let mut given = Vec::new();
+    for key in DIRECTION_KEYS {
+        if let Some(v) = p.take_raw(T, key)? {
+            given.push((key, number(key, &v, "degrees")?));
+        }
+    }
+    let [(key, deg)] = given[..] else {
+        return Err(Error::InvalidInput(format!(
+            "current.speed needs exactly one of current.direction or current.direction_towards (degrees, where it flows towards, spatial, from x towards y) or current.direction_from (where it comes from), got {}",
+            if given.is_empty() { "none".to_string() } else { given.iter().map(|(k, _)| *k).collect::<Vec<_>>().join(" and ") }
+        )));
+    };
+    if !(deg.is_finite() && deg.abs() <= 360.0) {
+        return Err(Error::InvalidInput(format!(
+            "current.{key} must be within ±360 degrees, got {deg}"
+        )));
+    }
+    let towards = if key == "direction_from" {
+        deg + 180.0
+    } else {
+        deg
+    }
+    .to_radians();
+    let v = [speed * towards.cos(), speed * towards.sin(), 0.0];
+    p.record_value(
+        T,
+        "velocity",
+        toml::Value::Array(v.iter().map(|x| toml::Value::Float(*x)).collect()),
+    );
+    Ok(Some(v))
+}
+
 /// The current of the file's `[current]` table, if any (also read by `crossflow.rs`, whose drag
 /// acts on the velocity relative to the water).
 pub fn read(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Current>> {
@@ -105,6 +179,8 @@ pub fn read(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Current
             ));
         }
         [v[0].x, v[0].y, v[0].z]
+    } else if let Some(v) = speed_and_direction(p)? {
+        v
     } else {
         p.vec3(
             T,
