@@ -54,8 +54,9 @@ static NEXT: AtomicU64 = AtomicU64::new(1);
 /// factors.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Phasors {
-    pub omega: Vec<f64>,
-    pub phase: Vec<f64>,
+    /// Private: the memo keys on the identity of the components, which must not change.
+    omega: Vec<f64>,
+    phase: Vec<f64>,
     /// `δ` and `Δ = ROWS δ` (s), powers of two.
     delta: f64,
     span: f64,
