@@ -31,10 +31,12 @@ use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::grid::{check_periodic, periodic_weights};
+use crate::model::phasors::Phasors;
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
 use crate::solve::Account;
 use nalgebra::Vector3;
+use std::cell::Cell;
 use std::sync::Arc;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -52,6 +54,8 @@ pub struct Wind {
     pub angles: Vec<f64>,
     /// `(C_X, C_Y, C_N)` per angle.
     pub coefficients: Vec<[f64; 3]>,
+    /// The gusts' time factors `e^{i(ω_k t + φ_k)}`, fast (`crate::model::phasors`).
+    time: Phasors,
 }
 
 fn list(
@@ -121,6 +125,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     Ok(Some(Arc::new(Wind {
         speed,
         direction,
+        time: Phasors::new(gf.clone(), gp.clone()),
         gusts: (0..gf.len()).map(|k| (gf[k], ga[k], gp[k])).collect(),
         frontal_area,
         lateral_area,
@@ -129,6 +134,13 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         angles: angles.iter().map(|a| a.to_radians()).collect(),
         coefficients: (0..cx.len()).map(|k| [cx[k], cy[k], cn[k]]).collect(),
     })))
+}
+
+thread_local! {
+    /// The last gust speed this thread computed: `(wind, t, U(t))`, the wind by its time
+    /// factors' identity and `t` by its bits (the collocation asks for the same stage time
+    /// at every pass of its fixed point).
+    static LAST_SPEED: Cell<(u64, u64, f64)> = const { Cell::new((0, 0, 0.0)) };
 }
 
 const ACCOUNTS: [Account; 1] = [Account::supplied("wind")];
@@ -142,6 +154,29 @@ impl Wind {
                 .iter()
                 .map(|(w, a, ph)| a * (w * t + ph).cos())
                 .sum::<f64>()
+    }
+
+    /// [`Wind::speed_at`] with the gusts' time factors by the lattice of [`Phasors`]: equal to
+    /// the direct sum to round-off (docs/explanation/fast-sea.md).
+    pub fn speed_fast(&self, t: f64) -> f64 {
+        if self.gusts.is_empty() {
+            return self.speed;
+        }
+        let key = self.time.key();
+        let (k, tb, u) = LAST_SPEED.with(|c| c.get());
+        if k == key && tb == t.to_bits() {
+            return u;
+        }
+        let u = self.speed
+            + self.time.with_at(t, |re, _| {
+                self.gusts
+                    .iter()
+                    .zip(re)
+                    .map(|((_, a, _), c)| a * c)
+                    .sum::<f64>()
+            });
+        LAST_SPEED.with(|c| c.set((key, t.to_bits(), u)));
+        u
     }
 
     /// The coefficients at the relative angle `gamma` (rad), periodic linear interpolation.
@@ -158,7 +193,16 @@ impl Wind {
         v: &Vector3<f64>,
         t: f64,
     ) -> (Vector3<f64>, Vector3<f64>) {
-        let u = self.speed_at(t);
+        self.loads_at_speed(qt, v, self.speed_at(t))
+    }
+
+    /// [`Wind::loads`] at the wind speed `u` (m/s).
+    pub fn loads_at_speed(
+        &self,
+        qt: &nalgebra::Matrix3<f64>,
+        v: &Vector3<f64>,
+        u: f64,
+    ) -> (Vector3<f64>, Vector3<f64>) {
         let wind = Vector3::new(u * self.direction.cos(), u * self.direction.sin(), 0.0);
         let rel = qt * wind - v;
         let vr2 = rel.x * rel.x + rel.y * rel.y;
@@ -191,7 +235,7 @@ impl Force for Wind {
         true
     }
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
-        let (f, m) = self.loads(&fr.qt, &fr.nu(z)[0], t);
+        let (f, m) = self.loads_at_speed(&fr.qt, &fr.nu(z)[0], self.speed_fast(t));
         g.force(Sys::Trans, Some(0), f);
         g.force(Sys::Rot, Some(0), m);
     }
@@ -210,11 +254,61 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_fast_gust_sum_is_the_direct_sum_to_round_off_over_an_hour() {
+        let mut st: u64 = 7;
+        let mut u = || {
+            st = st
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (st >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let gusts: Vec<(f64, f64, f64)> = (0..100)
+            .map(|_| (0.001 * 500f64.powf(u()), 0.8 * u(), 6.283 * u()))
+            .collect();
+        let w = Wind {
+            speed: 15.0,
+            direction: 0.3,
+            time: Phasors::new(
+                gusts.iter().map(|g| g.0).collect(),
+                gusts.iter().map(|g| g.2).collect(),
+            ),
+            gusts: gusts.clone(),
+            frontal_area: 182.0,
+            lateral_area: 533.0,
+            length: 76.2,
+            air_density: 1.225,
+            angles: vec![0.0, std::f64::consts::PI],
+            coefficients: vec![[0.6, 0.0, 0.0], [-0.7, 0.0, 0.0]],
+        };
+        let scale = 15.0 + gusts.iter().map(|g| g.1).sum::<f64>();
+        let gauss = 0.5 - 3f64.sqrt() / 6.0;
+        for n in (0..7200).chain(7150..7200) {
+            for c in [gauss, 0.5, 1.0 - gauss] {
+                let t = 0.5 * (n as f64 + c);
+                // U(t) = speed + Σ a_k cos(ω_k t + φ_k), written out.
+                let want = 15.0
+                    + gusts
+                        .iter()
+                        .map(|(om, a, ph)| a * (om * t + ph).cos())
+                        .sum::<f64>();
+                let got = w.speed_fast(t);
+                assert!(
+                    (got - want).abs() <= 1e-12 * scale,
+                    "t = {t}: {got} vs {want}"
+                );
+                // again at the same time (the collocation's passes): the same bits
+                assert_eq!(w.speed_fast(t).to_bits(), got.to_bits());
+            }
+        }
+    }
+
+    #[test]
     fn a_head_wind_on_a_table_gives_the_stated_loads() {
         let w = Wind {
             speed: 20.0,
             direction: std::f64::consts::PI, // blowing towards −x
             gusts: vec![],
+            time: Phasors::new(vec![], vec![]),
             frontal_area: 300.0,
             lateral_area: 900.0,
             length: 80.0,
