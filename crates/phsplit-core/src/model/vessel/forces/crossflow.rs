@@ -35,7 +35,7 @@ use super::current::Current;
 use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::solve::Account;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
@@ -59,7 +59,7 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
     if !p.has(T) {
         return Ok(None);
     }
-    let draft = p.f64(T, "draft", "m", Range::Positive)?;
+    let draft = p.f64(T, "draft", "m", Range::Physical(&physical::DRAFT))?;
     let cd = p.f64(
         T,
         "drag_coefficient",

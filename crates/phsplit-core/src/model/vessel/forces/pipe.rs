@@ -34,7 +34,7 @@ use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::catenary::Catenary;
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::model::vessel::state::VesselState;
 use crate::solve::Account;
 use nalgebra::{Matrix3, Vector2, Vector3};
@@ -81,7 +81,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         return Ok(None);
     }
     let weight = p.f64(T, "submerged_weight", "N/m", Range::Positive)?;
-    let water_depth = p.f64(T, "water_depth", "m", Range::Positive)?;
+    let water_depth = p.f64(T, "water_depth", "m", Range::Physical(&physical::WATER_DEPTH))?;
     let hang_off: Vector3<f64> = p
         .vec3(T, "hang_off", None, "m, body frame", Range::Finite)?
         .into();
@@ -140,6 +140,14 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
                 "pipe.departure_angle must lie strictly between 0 and 90 (degrees from the horizontal), got {a}"
             )));
         }
+        let r = physical::DEPARTURE_ANGLE;
+        if !r.contains(a) {
+            return Err(Error::InvalidInput(format!(
+                "pipe.departure_angle must lie within {} (degrees from the horizontal; {}), got {a}",
+                r.interval(),
+                r.why
+            )));
+        }
         Mode::DepartureAngle(a.to_radians())
     } else {
         let td = td.expect("one was given");
@@ -152,7 +160,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         Mode::Touchdown(Vector2::new(td[0][0], td[1][0]))
     };
     let needs_direction = !matches!(mode, Mode::Touchdown(_));
-    let dir = p.opt_f64(T, "lay_direction", "degrees", Range::Finite)?;
+    let dir = p.opt_f64(T, "lay_direction", "degrees", Range::Physical(&physical::ANGLE_DEG))?;
     let lay_speed = p
         .opt_f64(T, "lay_speed", "m/s", Range::NonNegative)?
         .unwrap_or(0.0);
