@@ -315,7 +315,15 @@ fn dumps_toml(d: &Bound<'_, PyDict>) -> PyResult<String> {
 /// low, high, whether each end is allowed, and why the range is where it is.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
-fn physical_ranges() -> Vec<(&'static str, &'static str, f64, f64, bool, bool, &'static str)> {
+fn physical_ranges() -> Vec<(
+    &'static str,
+    &'static str,
+    f64,
+    f64,
+    bool,
+    bool,
+    &'static str,
+)> {
     phsplit_core::model::vessel::params::physical::ALL
         .iter()
         .map(|(name, unit, r)| (*name, *unit, r.lo, r.hi, r.lo_closed, r.hi_closed, r.why))

@@ -42,8 +42,15 @@ impl Eq for Physical {}
 
 impl Physical {
     pub fn contains(&self, v: f64) -> bool {
-        (if self.lo_closed { v >= self.lo } else { v > self.lo })
-            && (if self.hi_closed { v <= self.hi } else { v < self.hi })
+        (if self.lo_closed {
+            v >= self.lo
+        } else {
+            v > self.lo
+        }) && (if self.hi_closed {
+            v <= self.hi
+        } else {
+            v < self.hi
+        })
     }
 
     pub fn interval(&self) -> String {
@@ -607,7 +614,10 @@ mod tests {
             .required_choice("a", "kind", &["tunnel", "azimuth"])
             .unwrap_err()
             .to_string();
-        assert!(e.contains("missing field `kind`") && e.contains("'tunnel'"), "{e}");
+        assert!(
+            e.contains("missing field `kind`") && e.contains("'tunnel'"),
+            "{e}"
+        );
         for (name, _, r) in physical::ALL {
             assert!(r.lo < r.hi && !r.why.is_empty(), "{name}");
         }

@@ -10,7 +10,7 @@
 //! draught `T` and the 2-D drag coefficient `C_d` constant along it (Fossen takes `C_d` from
 //! Hoerner's curve of `B/(2T)`; give the value), `v_r` the sway velocity relative to the water.
 //!
-//! Table `[crossflow_drag]` (optional): `draft` (m, > 0), `drag_coefficient` (> 0, ≤ 5),
+//! Table `[crossflow_drag]` (optional): `draft` (m, in (0, 40], `params::physical::DRAFT`), `drag_coefficient` (> 0, ≤ 5),
 //! `x_aft`, `x_fore` (m, body x of the hull's ends, `x_aft < x_fore`, within ±1000 m). The water
 //! density is the vessel's (`vessel.water_density`).
 //!

@@ -1,7 +1,7 @@
 //! Thrusters and thrust allocation: the actuators of the DP controller (docs/model.md §5.8).
 //!
 //! Table `[thrusters]` (optional; read with the controller, whose force they deliver):
-//! - `hull_length`, `hull_beam` (m, > 0): the hull's box, `|x| ≤ L/2`, `|y| ≤ B/2`, `|z| ≤ B/2`
+//! - `hull_length`, `hull_beam` (m, in (0, 500] and (0, 150], `physical::HULL_LENGTH`, `HULL_BEAM`): the hull's box, `|x| ≤ L/2`, `|y| ≤ B/2`, `|z| ≤ B/2`
 //!   about the body origin, inside which every thruster must sit;
 //! - `unit`: a list of thrusters (`[[thrusters.unit]]` tables), each with
 //!   - `kind`: `"tunnel"` (a fixed transverse axis, thrust of either sign), `"azimuth"` (turns
@@ -128,7 +128,12 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
     if !p.has(T) {
         return Ok(None);
     }
-    let length = p.f64(T, "hull_length", "m", Range::Physical(&physical::HULL_LENGTH))?;
+    let length = p.f64(
+        T,
+        "hull_length",
+        "m",
+        Range::Physical(&physical::HULL_LENGTH),
+    )?;
     let beam = p.f64(T, "hull_beam", "m", Range::Physical(&physical::HULL_BEAM))?;
     let raw = p.take_raw(T, "unit")?.ok_or_else(|| {
         Error::Parse("missing field `unit` in [thrusters]: a list of [[thrusters.unit]] tables (kind, position, max_thrust, ...)".into())
