@@ -398,7 +398,12 @@ def dense_output(sol, times):
     if not prov or "vessel_toml" not in prov:
         raise _core.InvalidInputError("this Solution does not record its vessel (it was assembled from several "
                                       "runs); rerun with save_at instead")
-    ts = np.asarray(times, dtype=float).reshape(-1)
+    if isinstance(times, (str, bytes, bool, np.bool_)):
+        raise _core.InvalidInputError(f"times must be a time or a sequence of times (s), numbers, got {times!r}")
+    try:
+        ts = np.asarray(times, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError(f"times must be a time or a sequence of times (s), numbers, got {times!r}") from None
     if ts.size == 0 or not np.all(np.isfinite(ts)) or ts.min() < sol.t[0] or ts.max() > sol.t[-1]:
         raise _core.InvalidInputError(f"times must be finite and within the run [{sol.t[0]:g}, {sol.t[-1]:g}] s")
     vessel = Vessel.from_toml_str(prov["vessel_toml"])
