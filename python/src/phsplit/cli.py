@@ -416,6 +416,8 @@ def _first_step(sc) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the run itself warns, once
         sol = phsplit.simulate(sc.vessel, settings=probe)
+    if sol.status == "interrupted":  # the core returned on a signal: the user asked to stop
+        raise KeyboardInterrupt
     if sol.status == "failed":
         raise UsageError(f"the run fails at its first step, so nothing was started: {sol.failure}")
 
