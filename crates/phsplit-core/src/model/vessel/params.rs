@@ -163,6 +163,12 @@ impl Range {
             return Ok(());
         }
         if let (Range::Physical(r), true) = (self, v.is_finite()) {
+            if r.lo == 0.0 && !r.lo_closed && v <= 0.0 {
+                // A positive quantity: said as every other positive key says it.
+                return Err(Error::InvalidInput(format!(
+                    "{name} must be > 0 ({unit}), got {v}"
+                )));
+            }
             return Err(Error::InvalidInput(format!(
                 "{name} must lie within {} ({unit}; {}), got {v}",
                 r.interval(),
@@ -618,6 +624,17 @@ mod tests {
             e.contains("missing field `kind`") && e.contains("'tunnel'"),
             "{e}"
         );
+        let e = p
+            .f64("a", "d", "m", Range::Physical(&physical::DRAFT))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("must lie within (0, 40]"), "{e}");
+        let mut q = Params::parse("[a]\nd = -1\n").unwrap();
+        let e = q
+            .f64("a", "d", "m", Range::Physical(&physical::WATER_DEPTH))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "a.d must be > 0 (m), got -1");
         for (name, _, r) in physical::ALL {
             assert!(r.lo < r.hi && !r.why.is_empty(), "{name}");
         }
