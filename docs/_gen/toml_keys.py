@@ -51,7 +51,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "kp_rotational": ("N m/rad", REQ, "proportional gains on the Euler-angle error"),
         "kd_rotational": ("N m s/rad", REQ, "derivative gains"),
         "ki_rotational": ("N m/(rad s)", REQ, "integral gains"),
-        "euler_reference": ("rad", REQ, "set attitude (roll, pitch, yaw)"),
+        "euler_reference": ("rad", REQ, "set attitude (roll, pitch, yaw), each within ±2π"),
         "position_reference": ("m", REQ, "set position, spatial frame"),
     },
     "external": {
@@ -74,20 +74,20 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
                          "six magnitudes `≥ 0` of Fossen's `X_|u|u … N_|r|r` (§5.11)"),
     },
     "crossflow_drag": {
-        "draft": ("m", REQ, "draught `T`, > 0 (§5.12)"),
+        "draft": ("m", REQ, "draught `T`, in (0, 40] (§5.12; [physical ranges](#physical-ranges))"),
         "drag_coefficient": ("-", REQ, "2-D drag coefficient `C_d`, in (0, 5]"),
         "x_aft": ("m", REQ, "body x of the aft end of the hull, within ±1000 m"),
         "x_fore": ("m", REQ, "body x of the fore end, `x_aft < x_fore`"),
     },
     "pipe": {
         "submerged_weight": ("N/m", REQ, "pipe weight in water `w`, > 0 (§5.6)"),
-        "water_depth": ("m", REQ, "seabed below the still water line, > 0"),
+        "water_depth": ("m", REQ, "seabed below the still water line, in (0, 11000]"),
         "hang_off": ("m", REQ, "where the pipe leaves the vessel, body frame, above the seabed"),
         "horizontal_tension": ("N", "one of four", "horizontal tension `H`, held by the tensioner"),
         "top_tension": ("N", "one of four", "top tension `T`, instead"),
-        "departure_angle": ("degrees", "one of four", "angle from the horizontal at the hang-off point, in (0, 90)"),
+        "departure_angle": ("degrees", "one of four", "angle from the horizontal at the hang-off point, in [5, 90)"),
         "touchdown": ("m", "one of four", "`[x, y]` of the touchdown point, spatial"),
-        "lay_direction": ("degrees", "required with a tension or an angle", "lay direction, spatial, from x towards y"),
+        "lay_direction": ("degrees", "required with a tension or an angle", "lay direction, spatial, from x towards y, within ±360"),
         "lay_speed": ("m/s", "0", "with `touchdown`: speed of the touchdown point along `lay_direction`"),
     },
     "spring": {
@@ -99,15 +99,15 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "natural_frequency": ("rad/s", REQ, "ω of Fossen's third-order reference model, > 0 (§5.7)"),
         "relative_damping": ("-", "1", "ζ, > 0 (1: critically damped)"),
         "positions": ("m", REQ, "rows of 3 numbers, spatial: the set points or waypoints"),
-        "headings": ("rad", "the fixed heading", "one yaw per row"),
-        "times": ("s", "one of `times`, `speed`", "increasing times of the rows"),
+        "headings": ("rad", "the fixed heading", "one yaw per row, within ±2π (radians, not degrees)"),
+        "times": ("s", "one of `times`, `speed`", "increasing times of the rows, within ±1e9 s"),
         "speed": ("m/s", "one of `times`, `speed`", "rows are waypoints passed at this speed, > 0"),
-        "start_time": ("s", "0", "with `speed`: when the set point starts moving"),
+        "start_time": ("s", "0", "with `speed`: when the set point starts moving, within ±1e9 s"),
         "interpolation": ("-", '"linear"', '`"linear"` or `"step"` between rows'),
     },
     "thrusters": {
-        "hull_length": ("m", REQ, "the hull's box `|x| ≤ L/2`, inside which every thruster sits (§5.8)"),
-        "hull_beam": ("m", REQ, "the box's `|y| ≤ B/2`, `|z| ≤ B/2`"),
+        "hull_length": ("m", REQ, "the hull's box `|x| ≤ L/2`, inside which every thruster sits, in (0, 500] (§5.8)"),
+        "hull_beam": ("m", REQ, "the box's `|y| ≤ B/2`, `|z| ≤ B/2`, in (0, 150]"),
         "unit": ("-", REQ, "the list of thrusters, `[[thrusters.unit]]` tables (below); rank 3 in surge, sway and yaw"),
     },
     "thrusters.unit": {
@@ -115,7 +115,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "position": ("m", REQ, "body frame, from the body origin"),
         "max_thrust": ("N", REQ, "> 0"),
         "min_thrust": ("N", "−max_thrust (tunnel); required (fixed)", "tunnel and fixed: the reverse thrust, < 0"),
-        "angle": ("degrees", "90 (tunnel), 0 (fixed)", "tunnel and fixed: the axis in the body x–y plane, from x towards y"),
+        "angle": ("degrees", "90 (tunnel), 0 (fixed)", "tunnel and fixed: the axis in the body x–y plane, from x towards y, within ±360"),
         "weight": ("-", "1", "cost of its thrust in the allocation, > 0"),
         "thrust_rate": ("N/s", "none", "fastest change of thrust, > 0"),
         "turn_rate": ("degrees/s", "none", "azimuth: fastest turn, > 0"),
@@ -154,16 +154,22 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "gamma": ("-", "3.3", "JONSWAP peak enhancement"),
         "spectrum": ("-", '"jonswap"', '`"jonswap"` or `"pierson-moskowitz"`, through wavespectra'),
         "direction": ("degrees", "0", "the direction the waves travel towards"),
+        "direction_towards": ("degrees", "none", "the same as `direction` (give one of the three)"),
+        "direction_from": ("degrees", "none", "the direction the waves come from, instead"),
         "spreading": ("-", "none (long-crested)", "exponent `s` of the cos-2s spreading function"),
         "seed": ("-", "0", "the same seed, the same sea"),
         "components": ("-", "200", "number of regular components, 1 to 10,000"),
         "omega_range": ("rad/s", "[0.5, 3] ω_p", "two increasing frequencies > 0"),
         "hydro": ("-", "none", "a Capytaine dataset (path relative to the scenario) for the transfer functions"),
-        "symmetric": ("-", "false", "mirror 0–180 degrees for a port–starboard symmetric hull"),
+        "symmetric": ("-", "false", "mirror 0–180 degrees for a port–starboard symmetric hull; without it, waves "
+                      "from a direction the dataset does not cover are refused"),
+        "hydro_checks": ("-", '"refuse"', '`"refuse"` a dataset that fails a physics check, or `"warn"` and use it'),
     },
     "environment.wind": {
         "speed": ("m/s", REQ, "mean speed at 10 m"),
         "direction": ("degrees", "0", "towards"),
+        "direction_towards": ("degrees", "none", "the same as `direction` (give one of the three)"),
+        "direction_from": ("degrees", "none", "where the wind comes from, instead"),
         "spectrum": ("-", '"npd"', '`"npd"`, `"harris"` or `"none"`: the gust spectrum'),
         "seed": ("-", "0", "the gusts' seed"),
         "components": ("-", "100", "number of gust components"),
@@ -344,6 +350,46 @@ def table_md(table: str, have: dict[str, set[str]]) -> str:
     return "\n".join(lines)
 
 
+#: Which keys each physical range of the core (``_core.physical_ranges``) bounds.
+RANGE_KEYS = {
+    "hull length": "`thrusters.hull_length`",
+    "hull beam": "`thrusters.hull_beam`",
+    "draught": "`crossflow_drag.draft`",
+    "water depth": "`pipe.water_depth`",
+    "angle in radians": "`setpoint.headings`, `control.euler_reference`",
+    "angle in degrees": "`pipe.lay_direction`, `thrusters.unit[i].angle`",
+    "pipe departure angle": "`pipe.departure_angle`",
+    "schedule time": "`setpoint.times`, `setpoint.start_time`, `current.times`",
+}
+
+
+def ranges_md() -> str:
+    """The physical ranges: the core's (asked of it) and those of the Python layer."""
+    from phsplit import events
+
+    rows = ["| range | unit | allowed | keys | why |", "|---|---|---|---|---|"]
+    got = _core.physical_ranges()
+    missing = {name for name, *_ in got} ^ set(RANGE_KEYS)
+    if missing:
+        raise SystemExit(f"toml_keys.py: RANGE_KEYS and the core's physical ranges differ: {sorted(missing)}")
+    for name, unit, lo, hi, lo_closed, hi_closed, why in got:
+        interval = f"{'[' if lo_closed else '('}{lo:g}, {hi:g}{']' if hi_closed else ')'}"
+        rows.append(f"| {name} | {unit} | {interval} | {RANGE_KEYS[name]} | {why} |")
+    sea_keys = {"tp": "`environment.waves.tp`", "direction": "`environment.waves` and `environment.wind`: "
+                 "`direction`, `direction_towards`, `direction_from`", "height": "`environment.wind.height`",
+                 "length": "`environment.wind.length` (with `ship_type`)"}
+    for key, (lo, hi, unit, why) in sea.RANGES.items():
+        rows.append(f"| sea: {key} | {unit} | [{lo:g}, {hi:g}] | {sea_keys[key]} | {why} |")
+    rows += [
+        f"| sweep size | cases | 1 to {batch.MAX_CASES} | `sweep.samples`, a grid's product | a larger sweep is a slip; split it |",
+        "| sweep seed | - | 0 to 2⁶³ − 1 | `sweep.seed` | an integer, not a boolean |",
+        f"| local workers | processes | 1 to {batch.MAX_WORKERS} | `phsplit sweep --workers` | more than any machine has cores |",
+        f"| roll event | degrees | (0, {events.ANGLE_LIMITS['roll_beyond']:g}) | `phsplit.events.roll_beyond` | a roll beyond 180° is a roll the other way |",
+        f"| pitch event | degrees | (0, {events.ANGLE_LIMITS['pitch_beyond']:g}) | `phsplit.events.pitch_beyond` | a ZYX pitch never exceeds 90° |",
+    ]
+    return "\n".join(rows)
+
+
 def render() -> str:
     have = check()
     parts = []
@@ -359,4 +405,10 @@ def render() -> str:
         for t in tables:
             name = "[[thrusters.unit]]" if t == "thrusters.unit" else f"[{t}]"
             parts.append(f"### `{name}`\n\nRead by {SOURCE[t]}.\n\n{table_md(t, have)}\n")
+    parts.append("## Physical ranges\n\nA length, angle or time beyond what any vessel or sea has is a slip (a unit, a "
+                 "digit) and is refused by name, with the range and the reason (`crates/phsplit-core/src/model/vessel/"
+                 "params.rs`, `physical`; the sweep and event limits in `phsplit.batch` and `phsplit.events`). Besides, "
+                 "booleans must be `true` or `false` (never a string or a number), a thruster's `kind` is required, "
+                 "and waves from a direction a hydrodynamic dataset does not cover are refused, not extrapolated.\n\n"
+                 + ranges_md() + "\n")
     return "\n".join(parts)

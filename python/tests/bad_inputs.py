@@ -66,12 +66,12 @@ class CliError(Exception):
     """What the CLI printed for a bad input: its one-line error (exit status 2, no traceback)."""
 
 
-def cli(*args: str, files: dict[str, bytes] | None = None) -> Callable[[], object]:
-    """Run ``phsplit <args>`` in a fresh folder (holding ``files``) with ``--out out``-style
-    arguments relative to it. Raises :class:`CliError` with the message when the CLI exits 2
-    with one line on stderr and no traceback and wrote nothing outside the folder; anything else
-    (exit 0, a traceback, a stray file) is returned or raised as an AssertionError, which the
-    catalogue's test reports."""
+def cli(*args: str, files: dict[str, bytes | None] | None = None) -> Callable[[], object]:
+    """Run ``phsplit <args>`` in a fresh folder (holding ``files``; ``None`` for a folder) with
+    ``--out out``-style arguments relative to it. Raises :class:`CliError` with the message when
+    the CLI exits 2 with one line on stderr and no traceback, wrote nothing outside the folder and
+    left no file in it besides ``files``; anything else (exit 0, a traceback, a stray or leftover
+    file) is returned or raised as an AssertionError, which the catalogue's test reports."""
 
     def run():
         import contextlib
@@ -84,8 +84,12 @@ def cli(*args: str, files: dict[str, bytes] | None = None) -> Callable[[], objec
             d = os.path.join(top, "work")
             os.makedirs(d)
             for name, data in (files or {}).items():
+                if data is None:
+                    os.makedirs(os.path.join(d, name))
+                    continue
                 with open(os.path.join(d, name), "wb") as f:
                     f.write(data)
+            before = _files_under(d)
             err, out = io.StringIO(), io.StringIO()
             os.chdir(d)
             try:
@@ -97,14 +101,22 @@ def cli(*args: str, files: dict[str, bytes] | None = None) -> Callable[[], objec
             finally:
                 os.chdir(here)
             stray = [n for n in os.listdir(top) if n != "work"]
+            left = sorted(_files_under(d) - before)
             lines = err.getvalue().strip().splitlines()
         assert not stray, f"wrote outside the working folder: {stray}"
+        if code == 2:
+            assert not left, f"a refused command left files behind: {left}"
         assert "Traceback" not in err.getvalue(), err.getvalue()
         if code == 2 and len(lines) == 1 and lines[0].startswith("phsplit: error: "):
             raise CliError(lines[0][len("phsplit: error: "):])
         return code, err.getvalue()
 
     return run
+
+
+def _files_under(d: str) -> set[str]:
+    """Every file below ``d`` (hidden ones too), relative to it."""
+    return {os.path.relpath(os.path.join(r, f), d) for r, _, fs in os.walk(d) for f in fs}
 
 
 E = phsplit.InvalidInputError
@@ -474,4 +486,435 @@ def _cli_on_batch(*args: str) -> Callable[[], object]:
 CATALOGUE += [
     Bad("CLI: rerun of a sweep's batch file", _cli_on_batch("rerun"), C, ("cases of a sweep", "sweep_case")),
     Bad("CLI: plot of a sweep's batch file", _cli_on_batch("plot"), C, ("cases of a sweep", "sweep_case")),
+]
+
+# ------------------------------------------------------------------------------------------
+# sweep files and the cluster (nothing written, nothing started)
+
+_SWEEP_HEAD = b'[simulation]\nh = 1.0\nt_span = [0.0, 2.0]\n[sweep]\n'
+_MASS_RANGE = b'[sweep.parameters]\n"vessel.mass" = {low = 6e6, high = 7e6}\n'
+_MASS_GRID = b'[sweep.parameters]\n"vessel.mass" = [6e6, 7e6]\n'
+
+
+def sweep_cli(sweep: bytes, *extra: str) -> Callable[[], object]:
+    """``phsplit sweep s.toml --out st <extra>`` on a sweep file."""
+    return cli("sweep", "s.toml", "--out", "st", "--no-progress", *extra, files={"s.toml": sweep})
+
+
+def _random(lines: bytes, params: bytes = _MASS_RANGE) -> bytes:
+    return _SWEEP_HEAD + b'mode = "random"\n' + lines + params
+
+
+_GOOD_RANDOM = _random(b"samples = 2\nseed = 1\n")
+
+
+def _load_sweep_text(text: bytes) -> Callable[[], object]:
+    def run():
+        from phsplit.batch import load_sweep
+
+        with tempfile.TemporaryDirectory() as d:
+            p = os.path.join(d, "s.toml")
+            with open(p, "wb") as f:
+                f.write(text)
+            return load_sweep(p)
+    return run
+
+
+def _folder(name: str) -> str:
+    """A fresh folder ``name`` in a temporary folder."""
+    p = os.path.join(tempfile.mkdtemp(), name)
+    os.makedirs(p)
+    return p
+
+
+def _run_sweep(**kw) -> Callable[[], object]:
+    def run():
+        from phsplit.batch import load_sweep, run_sweep
+
+        with tempfile.TemporaryDirectory() as d:
+            p = os.path.join(d, "s.toml")
+            with open(p, "wb") as f:
+                f.write(_GOOD_RANDOM)
+            store = os.path.join(d, "st")
+            try:
+                return run_sweep(load_sweep(p), store, progress=False, **kw)
+            finally:
+                assert not os.path.exists(store), "a refused sweep created its store"
+    return run
+
+
+CATALOGUE += [
+    Bad("CLI: sweep with a negative seed", sweep_cli(_random(b"samples = 2\nseed = -1\n")), C,
+        ("sweep.seed", "integer from 0", "-1")),
+    Bad("CLI: sweep with a fractional seed", sweep_cli(_random(b"samples = 2\nseed = 1.5\n")), C,
+        ("sweep.seed", "integer", "1.5")),
+    Bad("CLI: sweep with a boolean seed", sweep_cli(_random(b"samples = 2\nseed = true\n")), C,
+        ("sweep.seed", "integer", "True")),
+    Bad("CLI: sweep with a boolean sample count", sweep_cli(_random(b"samples = true\n")), C,
+        ("sweep.samples", "integer from 1", "True")),
+    Bad("CLI: sweep with a fractional sample count", sweep_cli(_random(b"samples = 2.5\n")), C,
+        ("sweep.samples", "integer", "2.5")),
+    Bad("CLI: sweep with zero samples", sweep_cli(_random(b"samples = 0\n")), C, ("sweep.samples", "from 1")),
+    Bad("CLI: sweep range with low above high",
+        sweep_cli(_random(b"samples = 2\n", b'[sweep.parameters]\n"vessel.mass" = {low = 7e6, high = 6e6}\n')), C,
+        ("sweep.parameters.vessel.mass", "low <= high", "7000000.0")),
+    Bad("CLI: sweep range to infinity",
+        sweep_cli(_random(b"samples = 2\n", b'[sweep.parameters]\n"vessel.mass" = {low = 6e6, high = inf}\n')), C,
+        ("sweep.parameters.vessel.mass", "finite", "inf")),
+    Bad("CLI: sweep range with a misspelt bound",
+        sweep_cli(_random(b"samples = 2\n", b'[sweep.parameters]\n"vessel.mass" = {low = 6e6, hihg = 7e6}\n')), C,
+        ("sweep.parameters.vessel.mass", "low = ..., high = ...", "hihg")),
+    Bad("CLI: binary sweep file", sweep_cli(b"\x00\x01\xff\xfe\x80"), C, ("s.toml", "UTF-8")),
+    Bad("CLI: sweep file that is a folder", cli("sweep", "d", "--out", "st", files={"d": None}), C,
+        ("sweep file", "'d'", "folder")),
+    Bad("CLI: sweep file that does not exist", cli("sweep", "nowhere.toml", "--out", "st"), C,
+        ("nowhere.toml", "does not exist")),
+    Bad("CLI: sweep with an unknown mode", sweep_cli(_SWEEP_HEAD + b'mode = "latin"\n' + _MASS_GRID), C,
+        ("sweep.mode", "'grid' or 'random'", "latin")),
+    Bad("CLI: grid sweep with a seed", sweep_cli(_SWEEP_HEAD + b'mode = "grid"\nseed = 3\n' + _MASS_GRID), C,
+        ("sweep.seed", "random")),
+    Bad("CLI: grid sweep of ten million cases", sweep_cli(
+        _SWEEP_HEAD + b'mode = "grid"\n[sweep.parameters]\n' + b"".join(
+            f'"control.kp_translational[{i}]" = [{", ".join(str(1e5 * (k + 1)) for k in range(10))}]\n'.encode()
+            for i in range(3)) + b"".join(
+            f'"control.kd_translational[{i}]" = [{", ".join(str(1e6 * (k + 1)) for k in range(10))}]\n'.encode()
+            for i in range(3)) + b'"control.kp_rotational[2]" = [' + ", ".join(
+            str(1e8 * (k + 1)) for k in range(10)).encode() + b"]\n"), C, ("10000000 cases", "at most 1000000")),
+    Bad("CLI: sweep with -2 workers", sweep_cli(_GOOD_RANDOM, "--workers", "-2"), C,
+        ("--workers", "integer from 1", "-2")),
+    Bad("CLI: sweep with no workers", sweep_cli(_GOOD_RANDOM, "--workers", "0"), C, ("--workers", "from 1")),
+    Bad("CLI: sweep with a million workers", sweep_cli(_GOOD_RANDOM, "--workers", "1000000"), C,
+        ("--workers", "to 512")),
+    Bad("CLI: sweep on a scheduler where nothing listens",
+        sweep_cli(_GOOD_RANDOM, "--scheduler", "tcp://127.0.0.1:1"), C,
+        ("cannot reach the scheduler", "tcp://127.0.0.1:1")),
+    Bad("CLI: sweep on a scheduler address without a port", sweep_cli(_GOOD_RANDOM, "--scheduler", "tcp://localhost"),
+        C, ("--scheduler", "tcp://host:8786", "tcp://localhost")),
+    Bad("CLI: sweep on an http address", sweep_cli(_GOOD_RANDOM, "--scheduler", "http://127.0.0.1:8787"), C,
+        ("--scheduler", "tcp, tls")),
+    Bad("CLI: sweep with both workers and a scheduler",
+        sweep_cli(_GOOD_RANDOM, "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"), C,
+        ("--workers", "--scheduler", "not both")),
+    Bad("CLI: sweep store that is a file",
+        cli("sweep", "s.toml", "--out", "st", files={"s.toml": _GOOD_RANDOM, "st": b"x"}), C,
+        ("store", "'st'", "is a file")),
+    Bad("sweep file that is a folder", lambda: __import__("phsplit.batch").batch.load_sweep(_folder("sweeps.toml")), E,
+        ("sweep file", "sweeps.toml", "is a folder")),
+    Bad("CLI: sweep with a zero step", sweep_cli(_GOOD_RANDOM.replace(b"h = 1.0", b"h = 0.0")), C,
+        ("s.toml", "h must be finite and > 0")),
+    Bad("sweep with a list as its seed", _load_sweep_text(_random(b"samples = 2\nseed = [1, 2]\n")), E,
+        ("sweep.seed", "integer", "[1, 2]")),
+    Bad("run_sweep with -2 workers", _run_sweep(n_workers=-2), E, ("workers", "integer from 1", "-2")),
+    Bad("run_sweep with workers given as a boolean", _run_sweep(n_workers=True), E, ("workers", "integer", "True")),
+    Bad("run_sweep on an unreachable scheduler", _run_sweep(scheduler="tcp://127.0.0.1:1"), E,
+        ("cannot reach the scheduler", "127.0.0.1:1")),
+]
+
+# ------------------------------------------------------------------------------------------
+# result files read back: rerun and plot check what they need, and where they write, first
+
+
+def _result_bytes(attrs: dict | None = None, drop: tuple[str, ...] = ()) -> bytes:
+    """A small run's result file, with ``attrs`` replaced and the variables ``drop`` removed."""
+    sol = phsplit.simulate(phsplit.Vessel.paper(), (0.0, 1.0), 0.5, "sp2")
+    ds = sol.to_xarray().drop_vars(list(drop))
+    ds.attrs.update(attrs or {})
+    with tempfile.TemporaryDirectory() as d:
+        p = os.path.join(d, "r.nc")
+        ds.to_netcdf(p)
+        with open(p, "rb") as f:
+            return f.read()
+
+
+def on_result(*args: str, attrs: dict | None = None, drop: tuple[str, ...] = (),
+              more: dict[str, bytes | None] | None = None) -> Callable[[], object]:
+    """``phsplit <args>`` with ``r.nc``, a run's file (damaged by ``attrs`` and ``drop``)."""
+    def run():
+        return cli(*args, files={"r.nc": _result_bytes(attrs, drop), **(more or {})})()
+    return run
+
+
+def rerun_damaged(attrs: dict | None = None, drop: tuple[str, ...] = ()) -> Callable[[], object]:
+    def run():
+        with tempfile.TemporaryDirectory() as d:
+            p = os.path.join(d, "r.nc")
+            with open(p, "wb") as f:
+                f.write(_result_bytes(attrs, drop))
+            with phsplit.open_dataset(p) as ds:
+                return phsplit.rerun(ds)
+    return run
+
+
+CATALOGUE += [
+    Bad("CLI: rerun of a file whose settings are not TOML", on_result("rerun", "r.nc", attrs={
+        "phsplit_settings": "[simulation\nh = "}), C, ("phsplit_settings", "damaged", "TOML syntax error")),
+    Bad("CLI: rerun of a file whose settings have no [simulation]", on_result("rerun", "r.nc", attrs={
+        "phsplit_settings": "h = 0.5\n"}), C, ("phsplit_settings", "no [simulation] table")),
+    Bad("CLI: rerun of a file whose step is text", on_result("rerun", "r.nc", attrs={
+        "phsplit_settings": '[simulation]\nt_span = [0.0, 1.0]\nh = "fast"\nmethod = "sp2"\nouter = "dissipative"\n'
+                            'save_every = 1\nlinear_flow = "gauss"\nledger = true\n'}), C,
+        ("phsplit_settings", "simulation.h", "fast")),
+    Bad("CLI: rerun of a file whose settings lack a key", on_result("rerun", "r.nc", attrs={
+        "phsplit_settings": '[simulation]\nt_span = [0.0, 1.0]\nh = 0.5\n'}), C,
+        ("phsplit_settings", "simulation.method is missing")),
+    Bad("CLI: rerun of a file whose settings are out of range", on_result("rerun", "r.nc", attrs={
+        "phsplit_settings": '[simulation]\nt_span = [0.0, 1.0]\nh = -0.5\nmethod = "sp2"\nouter = "dissipative"\n'
+                            'save_every = 1\nlinear_flow = "gauss"\nledger = true\n'}), C,
+        ("phsplit_settings", "h", "> 0")),
+    Bad("CLI: rerun of a file whose chunks are words", on_result("rerun", "r.nc", attrs={"phsplit_chunks": "two steps"}),
+        C, ("phsplit_chunks", "damaged", "step counts")),
+    Bad("CLI: rerun of a file whose chunks do not add up", on_result("rerun", "r.nc", attrs={"phsplit_chunks": "1 7"}),
+        C, ("phsplit_chunks", "add up to 8", "2 steps")),
+    Bad("CLI: rerun of a file whose vessel is damaged", on_result("rerun", "r.nc", attrs={
+        "phsplit_vessel": "[vessel]\nmass = -1\n"}), C, ("phsplit_vessel", "damaged")),
+    Bad("CLI: rerun of a file without its initial state", on_result("rerun", "r.nc", drop=("initial_state",)), C,
+        ("initial_state",)),
+    Bad("CLI: rerun into a folder that is a file", on_result("rerun", "r.nc", "--out", "f", more={"f": b"x"}), C,
+        ("--out", "'f'", "is a file")),
+    Bad("CLI: rerun onto a folder of the file's name", on_result("rerun", "r.nc", "--out", "o", more={"o": None,
+                                                                                                    "o/r.nc": None}),
+        C, ("o/r.nc", "folder of that name")),
+    Bad("CLI: rerun over its own file", on_result("rerun", "r.nc", "--out", "."), C,
+        ("would overwrite", "r.nc")),
+    Bad("CLI: plot of a result without energy", on_result("plot", "r.nc", drop=("energy",)), C,
+        ("no 'energy' variable", "position, euler, energy")),
+    Bad("CLI: plot of a result without time", on_result("plot", "r.nc", drop=("position",)), C,
+        ("no trajectory",)),
+    Bad("CLI: plot into an existing folder", on_result("plot", "r.nc", "--out", "img.png", more={"img.png": None}), C,
+        ("--out", "img.png", "is a folder")),
+    Bad("CLI: plot over the result file", on_result("plot", "r.nc", "--out", "r.nc"), C,
+        ("--out must end in .png",)),
+    Bad("CLI: plot of a result whose vessel is damaged", on_result("plot", "r.nc", attrs={
+        "phsplit_vessel": "[control\n"}), C, ("phsplit_vessel", "damaged")),
+    Bad("rerun of a result whose settings are damaged", rerun_damaged({"phsplit_settings": "not = [toml"}), E,
+        ("phsplit_settings", "damaged")),
+    Bad("rerun of a result whose chunks are negative", rerun_damaged({"phsplit_chunks": "-2"}), E,
+        ("phsplit_chunks", "step counts >= 1")),
+    Bad("rerun of a result whose control start is a word", rerun_damaged({
+        "phsplit_settings": '[simulation]\nt_span = [0.0, 1.0]\nh = 0.5\nmethod = "sp2"\nouter = "dissipative"\n'
+                            'save_every = 1\nlinear_flow = "gauss"\nledger = true\ncontrol_start = "soon"\n'}), E,
+        ("simulation.control_start", "soon", "'never'")),
+    Bad("plot of a result without energy",
+        lambda: __import__("phsplit.plotting").plotting.check_plottable(
+            phsplit.simulate(phsplit.Vessel.paper(), (0.0, 1.0), 0.5).to_xarray().drop_vars("energy")), E,
+        ("'energy'", "DP figure needs")),
+]
+
+# ------------------------------------------------------------------------------------------
+# lengths, angles and times beyond any vessel or sea (the physical ranges), guessed defaults
+
+_PIPE = ("[pipe]\nsubmerged_weight = 800.0\nwater_depth = {depth}\nhang_off = [-60.0, 0.0, 3.0]\n{fix}\n"
+         "lay_direction = {direction}\n[initial]")
+
+
+def _pipe(depth: str = "300.0", fix: str = "horizontal_tension = 5e5", direction: str = "0.0") -> str:
+    return _PIPE.format(depth=depth, fix=fix, direction=direction)
+
+
+_SETPOINT = ("[setpoint]\nnatural_frequency = 0.05\n{when}\npositions = [[780.0, 20.0, 0.0], [800.0, 20.0, 0.0]]\n"
+             "{extra}[initial]")
+_THRUSTERS = ("[thrusters]\nhull_length = {length}\nhull_beam = {beam}\n"
+              "[[thrusters.unit]]\n{kind}position = [37.0, 0.0, -3.0]\nmax_thrust = 3e5\n{tunnel}"
+              "[[thrusters.unit]]\nkind = \"azimuth\"\nposition = [-41.5, 7.0, -3.0]\nmax_thrust = 4.2e5\n{azimuth}"
+              "[[thrusters.unit]]\nkind = \"azimuth\"\nposition = [-41.5, -7.0, -3.0]\nmax_thrust = 6.55e5\n"
+              "[initial]")
+
+
+def _thrusters(length="83.0", beam="18.0", kind='kind = "tunnel"\n', tunnel="", azimuth="") -> str:
+    return _THRUSTERS.format(length=length, beam=beam, kind=kind, tunnel=tunnel, azimuth=azimuth)
+
+
+_DRAG = "[crossflow_drag]\ndraft = {draft}\ndrag_coefficient = 1.0\nx_aft = -36.0\nx_fore = 40.0\n\n[control]"
+
+CATALOGUE += [
+    Bad("cross-flow drag with a draught of 5 km", vessel_with("[control]", _DRAG.format(draft="5000.0")), E,
+        ("crossflow_drag.draft", "(0, 40]", "no ship draws more than 40 m", "5000")),
+    Bad("pipe in water 1000 km deep", vessel_with("[initial]", _pipe(depth="1e6")), E,
+        ("pipe.water_depth", "(0, 11000]", "1000000")),
+    Bad("pipe leaving the vessel at 1e-9 degrees",
+        vessel_with("[initial]", _pipe(fix="departure_angle = 1e-9")), E,
+        ("pipe.departure_angle", "[5, 90)", "20 water depths", "got 0.000000001")),
+    Bad("pipe laid towards 720 degrees", vessel_with("[initial]", _pipe(direction="720.0")), E,
+        ("pipe.lay_direction", "[-360, 360]", "720")),
+    Bad("thrusters on a hull 8.3 km long", vessel_with("[initial]", _thrusters(length="8300.0")), E,
+        ("thrusters.hull_length", "(0, 500]", "8300")),
+    Bad("thrusters on a hull 1.8 km wide", vessel_with("[initial]", _thrusters(beam="1800.0")), E,
+        ("thrusters.hull_beam", "(0, 150]", "1800")),
+    Bad("thruster without its kind", vessel_with("[initial]", _thrusters(kind="")), P,
+        ("missing field `kind`", "thrusters.unit[0]", "'tunnel', 'azimuth', 'fixed'")),
+    Bad("tunnel thruster at 450 degrees", vessel_with("[initial]", _thrusters(tunnel="angle = 450.0\n")), E,
+        ("thrusters.unit[0].angle", "[-360, 360]", "450")),
+    Bad("set-point headings in degrees", vessel_with("[initial]", _SETPOINT.format(
+        when="times = [0.0, 60.0]", extra="headings = [30.94, 30.94]\n")), E,
+        ("setpoint.headings[0]", "±2π", "degrees", "30.94")),
+    Bad("heading reference in degrees", vessel_with("euler_reference = [0.0, 0.0, 0.54]",
+                                                    "euler_reference = [0.0, 0.0, 30.94]"), E,
+        ("control.euler_reference[2]", "radians", "30.94")),
+    Bad("set-point time 1e12 s", vessel_with("[initial]", _SETPOINT.format(when="times = [0.0, 1e12]", extra="")), E,
+        ("setpoint.times[1]", "1e9 s", "1000000000000")),
+    Bad("set-point start 1e12 s", vessel_with("[initial]", _SETPOINT.format(
+        when="speed = 0.5\nstart_time = 1e12", extra="")), E, ("setpoint.start_time", "1e9 s")),
+    Bad("current table at 1e12 s", vessel_with("[initial]", "[current]\ntimes = [0.0, 1e12]\n"
+                                               "velocities = [[0.5, 0.0, 0.0], [0.5, 0.0, 0.0]]\n[initial]"), E,
+        ("current.times[1]", "1e9 s")),
+    Bad("CLI: vessel file with a 5 km draught",
+        cli(*SIM, "--t-end", "1", "--vessel", "v.toml", files={"v.toml": PAPER.replace(
+            "[control]", _DRAG.format(draft="5000.0"), 1).encode()}), C, ("crossflow_drag.draft", "40 m")),
+    Bad("CLI: scenario whose pipe leaves at 1e-9 degrees",
+        cli(*SIM, "--t-end", "1", "--vessel", "v.toml", files={"v.toml": PAPER.replace(
+            "[initial]", _pipe(fix="departure_angle = 1e-9"), 1).encode()}), C, ("pipe.departure_angle", "[5, 90)")),
+    Bad("CLI: rate-limited thrusters with rk4",
+        cli(*SIM, "--t-end", "1", "--method", "rk4", "--vessel", "v.toml", files={"v.toml": PAPER.replace(
+            "[initial]", _rated(), 1).encode()}), C, ("rate-limited thrusters", "splitting method")),
+]
+
+# ------------------------------------------------------------------------------------------
+# save_at and events
+
+
+def _events(*events) -> Callable[[], object]:
+    return sim(events=list(events))
+
+
+def _event(**kw) -> Callable[[], object]:
+    return lambda: phsplit.events.Event(**{"name": "e", "g": lambda t, y, v: y[18], **kw})
+
+
+CATALOGUE += [
+    Bad("save_at given as True", sim(save_at=True), E, ("save_at", "numbers", "True")),
+    Bad("save_at holding a boolean", sim(save_at=[1.0, False]), E, ("save_at", "numbers")),
+    Bad("save_at given as text", sim(save_at="5"), E, ("save_at", "numbers", "'5'")),
+    Bad("roll event beyond 400 degrees", lambda: phsplit.events.roll_beyond(400.0), E,
+        ("roll_beyond", "below 180", "never fire", "400")),
+    Bad("pitch event beyond 95 degrees", lambda: phsplit.events.pitch_beyond(95.0), E,
+        ("pitch_beyond", "below 90", "95")),
+    Bad("watch circle whose terminal is text", lambda: phsplit.events.watch_circle(5.0, terminal="no"), E,
+        ("watch_circle", "terminal must be True or False", "'no'")),
+    Bad("roll event whose terminal is a number", lambda: phsplit.events.roll_beyond(10.0, terminal=0), E,
+        ("roll_beyond", "terminal must be True or False", "0")),
+    Bad("event whose terminal is text", _event(terminal="no"), E, ("event 'e'", "terminal", "'no'")),
+    Bad("event without a name", _event(name=""), E, ("name", "non-empty string")),
+    Bad("event condition that is always NaN", _events(phsplit.events.Event("never", lambda t, y, v: math.nan)), E,
+        ("event 'never'", "finite number", "nan")),
+    Bad("event condition that fails", _events(phsplit.events.Event("broken", lambda t, y, v: y[99])), E,
+        ("event 'broken'", "raised IndexError")),
+    Bad("orthonormalize given as text", sim(orthonormalize="no"), E, ("orthonormalize", "True or False", "'no'")),
+    Bad("running_max given as a number", sim(running_max=1), E, ("running_max", "True or False")),
+    Bad("dense output at a word", lambda: phsplit.simulate(phsplit.Vessel.paper(), (0.0, 5.0), 0.5).at("a"), E,
+        ("times", "numbers", "'a'")),
+    Bad("event condition that returns text", _events(phsplit.events.Event("wordy", lambda t, y, v: "far")), E,
+        ("event 'wordy'", "finite number", "'far'")),
+]
+
+# ------------------------------------------------------------------------------------------
+# hydrodynamic data: no extrapolation over directions
+
+_BARGE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "box_barge_capytaine.nc")
+
+
+def _waves_from(direction: float, extra: str = "") -> Callable[[], object]:
+    return scenario(f'[simulation]\nt_span = [0.0, 1.0]\nh = 0.5\n[environment.waves]\nhs = 2.0\ntp = 8.0\n'
+                    f'omega_range = [0.35, 1.9]\nhydro = "{_BARGE}"\nhydro_checks = "warn"\n'
+                    f'direction = {direction}\n{extra}')
+
+
+CATALOGUE += [
+    Bad("waves from outside the dataset's directions", _waves_from(270.0), E,
+        ("environment.waves", "270 degrees", "outside the directions", "symmetric = true")),
+    Bad("spread waves reaching outside the dataset's directions", _waves_from(0.0, "spreading = 4.0\n"), E,
+        ("environment.waves", "outside the directions", "0, 22.5, 45")),
+]
+
+# ------------------------------------------------------------------------------------------
+# the FMU exporter checks what it packs
+
+_HOST_SO = os.path.join(os.path.dirname(phsplit.__file__), "_fmu", "binaries", "linux64", "phsplit_fmu.so")
+
+
+def _fmu_with(plat: str, data: bytes | None, name: str = "b.bin") -> Callable[[], object]:
+    return cli("fmu", "export", "-o", "v.fmu", "--binary", f"{plat}={name}", files={name: data})
+
+
+def _host_so() -> bytes:
+    with open(_HOST_SO, "rb") as f:
+        return f.read()
+
+
+CATALOGUE += [
+    Bad("CLI: FMU with a text file as the Windows DLL", _fmu_with("win64", b"this is not a DLL\n"), C,
+        ("win64 binary", "not a shared library", "Windows DLL (PE), 64-bit")),
+    Bad("CLI: FMU with a Linux library as the Windows DLL", lambda: _fmu_with("win64", _host_so())(), C,
+        ("win64 binary", "64-bit an ELF shared object", "Windows DLL")),
+    Bad("CLI: FMU with a 64-bit library as linux32", lambda: _fmu_with("linux32", _host_so())(), C,
+        ("linux32 binary", "64-bit", "32-bit")),
+    Bad("CLI: FMU with a folder as a binary", _fmu_with("darwin64", None, "lib"), C,
+        ("darwin64 binary", "is a folder")),
+    Bad("CLI: FMU with a shared library that is no FMU", _fmu_with(
+        "linux64", b"\x7fELF\x02\x01\x01" + b"\x00" * 9 + b"\x03\x00" + b"\x00" * 64), C,
+        ("linux64 binary", "fmi2Instantiate")),
+    Bad("FMU export with a script as the macOS binary", lambda: __import__("phsplit.fmu").fmu.export(
+        None, os.path.join(tempfile.mkdtemp(), "v.fmu"), binaries={"darwin64": _script()}), E,
+        ("darwin64 binary", "Mach-O dynamic library")),
+]
+
+
+def _script() -> str:
+    p = os.path.join(tempfile.mkdtemp(), "run.sh")
+    with open(p, "w") as f:
+        f.write("#!/bin/sh\necho hello\n")
+    return p
+
+
+# ------------------------------------------------------------------------------------------
+# hydrodynamic datasets named by a scenario
+
+
+def _hydro_file(data: bytes, extra: str = "") -> Callable[[], object]:
+    def run():
+        from phsplit import scenario as scn
+
+        with tempfile.TemporaryDirectory() as d:
+            with open(os.path.join(d, "h.nc"), "wb") as f:
+                f.write(data)
+            p = os.path.join(d, "s.toml")
+            with open(p, "w") as f:
+                f.write(f'[environment.waves]\nhs = 2.0\ntp = 8.0\nhydro = "h.nc"\n{extra}')
+            return scn.load(p)
+    return run
+
+
+def _barge_bytes() -> bytes:
+    with open(_BARGE, "rb") as f:
+        return f.read()
+
+
+CATALOGUE += [
+    Bad("hydrodynamic file that is text", _hydro_file(b"omega, added_mass\n1, 2\n"), E,
+        ("environment.waves.hydro", "not a NetCDF file")),
+    Bad("hydrodynamic file cut short", lambda: _hydro_file(_barge_bytes()[:4000])(), E,
+        ("environment.waves.hydro", "cannot read")),
+    Bad("hydrodynamic dataset with symmetric as text", lambda: _hydro_file(_barge_bytes(), 'symmetric = "no"\n')(), P,
+        ("environment.waves.symmetric", "true or false", "'no'")),
+    Bad("hydrodynamic checks of an unknown mode", lambda: _hydro_file(_barge_bytes(), 'hydro_checks = "maybe"\n')(), P,
+        ("environment.waves.hydro_checks", "'refuse'", "'maybe'")),
+    Bad("hydrodynamic file given as a number", scenario("[environment.waves]\nhs = 2.0\ntp = 8.0\nhydro = 5\n"), P,
+        ("environment.waves.hydro", "file path", "5")),
+]
+
+# ------------------------------------------------------------------------------------------
+# the sea's own ranges
+
+CATALOGUE += [
+    Bad("sea state peaking at 1000 s", scenario("[environment.waves]\nhs = 2.0\ntp = 1000.0\n"), E,
+        ("waves.tp", "[0.5, 40]", "1000")),
+    Bad("waves travelling towards 720 degrees", scenario("[environment.waves]\nhs = 2.0\ntp = 8.0\ndirection = 720.0\n"),
+        E, ("waves.direction", "[-360, 360]", "720")),
+    Bad("wind from 1000 degrees", scenario("[environment.wind]\nspeed = 10.0\ndirection_from = 1000.0\n"
+                                          "spectrum = \"none\"\n"), E,
+        ("environment.wind.direction_from", "[-360, 360]", "1000")),
+    Bad("wind measured 5 km up", scenario("[environment.wind]\nspeed = 10.0\nheight = 5000.0\n"), E,
+        ("wind.height", "[0.1, 500]", "5000")),
+    Bad("Blendermann windage of a hull 8 km long",
+        scenario('[environment.wind]\nspeed = 15.0\nship_type = "offshore supply vessel"\nfrontal_area = 200.0\n'
+                 'lateral_area = 600.0\nlength = 8000.0\n'), E, ("environment.wind.length", "500 m", "8000")),
 ]

@@ -46,6 +46,18 @@ SCENARIO_LINES = [
     "[vessel]", "mass = 7e6", "mass = -1", "[external]", "force = [1e5, 0.0, 0.0]", 'frame = "ned"',
     "[initial]", "euler = [0.1, 0.0, 0.0]", 'euler = "abc"', "[simulaton]", 'vessel = "nowhere.toml"',
     "garbage = = =", "\x00\x01", "\ufeff[simulation]", "ledger = false", 'linear_flow = "gauss"',
+    # the newer tables: the operation, drag, current, the sea
+    "[pipe]", "submerged_weight = 800.0", "water_depth = 300.0", "water_depth = 1e6", "hang_off = [-60.0, 0.0, 3.0]",
+    "horizontal_tension = 5e5", "departure_angle = 1e-9", "departure_angle = 45.0", "lay_direction = 0.0",
+    "lay_direction = 720.0", "[setpoint]", "natural_frequency = 0.05", "times = [0.0, 60.0]", "times = [0.0, 1e12]",
+    "positions = [[780.0, 20.0, 0.0], [800.0, 20.0, 0.0]]", "headings = [30.94, 30.94]", "headings = [0.5, 0.5]",
+    "speed = 0.5", "[thrusters]", "hull_length = 83.0", "hull_length = 8300.0", "hull_beam = 18.0",
+    "[[thrusters.unit]]", 'kind = "tunnel"', 'kind = "azimuth"', "position = [37.0, 0.0, -3.0]",
+    "position = [-41.5, 7.0, -3.0]", "max_thrust = 3e5", "thrust_rate = 3e4", "turn_rate = 10.0",
+    "[crossflow_drag]", "draft = 4.5", "draft = 5000.0", "drag_coefficient = 1.0", "x_aft = -36.0", "x_fore = 40.0",
+    "[current]", "velocity = [0.5, 0.0, 0.0]", "[environment.current]", "direction_towards = 90.0",
+    "[environment.waves]", "hs = 2.0", "hs = -1.0", "tp = 8.0", "direction = 270.0", "symmetric = \"no\"",
+    "[environment.wind]", "frontal_area = 200.0",
 ]
 
 
@@ -121,6 +133,75 @@ def test_no_cli_input_gives_a_traceback_a_stray_file_or_a_corrupt_one(tmp_path_f
         if f.suffix == ".nc":
             with phsplit.open_dataset(f) as ds:
                 assert ds.attrs["status"] in ("completed", "failed") and ds.sizes["time"] >= 1
+
+
+# ----------------------------------------------------------------------------------------------
+# fuzzing sweep files: each example also names a cluster that cannot work, so that none starts
+# workers; every one must be refused in one line, before anything is written
+
+SWEEP_LINES = [
+    "[simulation]", "h = 1.0", "t_span = [0.0, 2.0]", "h = 0", "[sweep]", 'mode = "grid"', 'mode = "random"',
+    'mode = "latin"', "mode = 3", "samples = 2", "samples = 0", "samples = true", "samples = 2.5", "samples = -3",
+    "seed = 1", "seed = -1", "seed = 1.5", "seed = true", 'seed = "x"', "seed = [1]", "[sweep.parameters]",
+    '"vessel.mass" = [6e6, 7e6]', '"vessel.mass" = {low = 6e6, high = 7e6}', '"vessel.mass" = {low = 7e6, high = 6e6}',
+    '"vessel.mass" = {low = 6e6, high = inf}', '"vessel.mass" = {low = 6e6}', '"vessel.mass" = ["a"]',
+    '"vessel.mass" = []', '"vessel.mas" = [1.0]', '"control.kp_translational[7]" = [1.0]', "parameters = 3",
+    "garbage = = =", "\x00\xff",
+]
+BAD_CLUSTERS = [["--workers", "-2"], ["--workers", "0"], ["--workers", "x"], ["--workers", "99999"],
+                ["--scheduler", "tcp://127.0.0.1:1"], ["--scheduler", "nope"], ["--scheduler", "http://127.0.0.1:80"],
+                ["--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], ["--scheduler", ""]]
+
+
+@st.composite
+def sweep_inputs(draw):
+    lines = draw(st.lists(st.sampled_from(SWEEP_LINES), max_size=10))
+    files = {}
+    target = draw(st.sampled_from(["s.toml", "s.toml", "d", "nowhere.toml"]))
+    if target == "s.toml":
+        files["s.toml"] = "\n".join(lines).encode("utf-8", "surrogatepass")
+    elif target == "d":
+        files["d"] = None
+    argv = ["sweep", target, "--no-progress"]
+    if draw(st.booleans()):
+        argv += ["--out", draw(st.sampled_from(["st", "s.toml", "sub/st"]))]
+    return argv + draw(st.sampled_from(BAD_CLUSTERS)), files
+
+
+@settings(max_examples=int(os.environ.get("PHSPLIT_SWEEP_FUZZ", "40")), deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(sweep_inputs())
+def test_no_sweep_file_or_cluster_argument_gives_a_traceback_or_leaves_a_file(tmp_path_factory, inp):
+    argv, files = inp
+    top = tmp_path_factory.mktemp("sweepfuzz")
+    work = top / "work"
+    work.mkdir()
+    for name, data in files.items():
+        if data is None:
+            (work / name).mkdir()
+        else:
+            (work / name).write_bytes(data)
+    before = sorted(p.relative_to(work) for p in work.rglob("*"))
+    err, out = io.StringIO(), io.StringIO()
+    here = os.getcwd()
+    os.chdir(work)
+    t0 = time.monotonic()
+    try:
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+            try:
+                code = main(argv)
+            except SystemExit as e:
+                code = e.code
+    finally:
+        os.chdir(here)
+    text = err.getvalue()
+    assert time.monotonic() - t0 < 10.0, (argv, "took too long")
+    assert "Traceback" not in text and "panicked" not in text, (argv, text)
+    assert code == 2, (argv, code, text)
+    lines = text.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("phsplit: error: "), (argv, text)
+    assert sorted(p.relative_to(work) for p in work.rglob("*")) == before, (argv, "wrote files")
+    assert sorted(p.name for p in top.iterdir()) == ["work"], (argv, list(top.iterdir()))
 
 
 # ----------------------------------------------------------------------------------------------

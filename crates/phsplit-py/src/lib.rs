@@ -311,6 +311,25 @@ fn dumps_toml(d: &Bound<'_, PyDict>) -> PyResult<String> {
     toml::to_string(&t).map_err(|e| InvalidInputError::new_err(format!("cannot write TOML: {e}")))
 }
 
+/// The physical ranges of length, angle and time keys (`params::physical`): name, unit,
+/// low, high, whether each end is allowed, and why the range is where it is.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn physical_ranges() -> Vec<(
+    &'static str,
+    &'static str,
+    f64,
+    f64,
+    bool,
+    bool,
+    &'static str,
+)> {
+    phsplit_core::model::vessel::params::physical::ALL
+        .iter()
+        .map(|(name, unit, r)| (*name, *unit, r.lo, r.hi, r.lo_closed, r.hi_closed, r.why))
+        .collect()
+}
+
 /// The keys of a [simulation] table with what each takes.
 #[pyfunction]
 fn settings_keys() -> Vec<(&'static str, &'static str)> {
@@ -368,6 +387,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_settings, m)?)?;
     m.add_function(wrap_pyfunction!(check_settings, m)?)?;
     m.add_function(wrap_pyfunction!(settings_keys, m)?)?;
+    m.add_function(wrap_pyfunction!(physical_ranges, m)?)?;
     m.add_function(wrap_pyfunction!(dumps_toml, m)?)?;
     m.add_function(wrap_pyfunction!(check_state, m)?)?;
     m.add_function(wrap_pyfunction!(vessel_tables, m)?)?;

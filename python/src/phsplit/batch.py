@@ -272,6 +272,9 @@ class Sweep:
         return f"case_{i:05d}_{digest}"
 
 
+#: Most cases of one sweep (a grid's product, or random samples).
+MAX_CASES = 1_000_000
+
 SWEEP_KEYS = {"mode": "'grid' or 'random'", "samples": "number of random cases", "seed": "random seed",
               "parameters": "table of parameter paths"}
 
@@ -283,15 +286,13 @@ def load_sweep(path: str) -> Sweep:
     ``mode = "random"``: every parameter is ``{low = ., high = .}`` (uniform) or a list (choice);
     ``samples`` cases drawn with ``seed``."""
     import difflib
-    import tomllib
 
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except FileNotFoundError:
-        raise _core.InvalidInputError(f"sweep file {path!r} does not exist") from None
-    except tomllib.TOMLDecodeError as e:
-        raise _core.ScenarioParseError(f"{path}: TOML syntax error: {e}") from None
+    if not isinstance(path, (str, os.PathLike)):
+        raise _core.InvalidInputError(f"the sweep file must be a path, got {type(path).__name__}")
+    path = os.fspath(path)
+    if os.path.isdir(path):
+        raise _core.InvalidInputError(f"sweep file {path!r} is a folder, not a TOML file")
+    data = scn._read_toml(path, "sweep file")
     sw = data.pop("sweep", None)
     if not isinstance(sw, dict):
         raise _core.ScenarioParseError(f"{path}: a sweep file needs a [sweep] table with [sweep.parameters]")
@@ -308,25 +309,52 @@ def load_sweep(path: str) -> Sweep:
     if not isinstance(params, dict) or not params:
         raise _core.ScenarioParseError(f"{path}: [sweep.parameters] must list at least one parameter")
     mode = sw.get("mode", "grid")
+    if mode not in ("grid", "random"):
+        raise _core.ScenarioParseError(f"{path}: sweep.mode must be 'grid' or 'random', got {mode!r}")
+    if mode == "grid":
+        for k in ("samples", "seed"):
+            if k in sw:
+                raise _core.ScenarioParseError(f"{path}: sweep.{k} goes with mode = \"random\"; a grid sweep's cases "
+                                               "are every combination of the lists")
     keys = list(params)
     d0 = sc.vessel.to_dict()
     for k in keys:
         _resolve(d0, k)  # the paths are checked now; the values case by case
         spec = params[k]
+        if isinstance(spec, dict) and set(spec) != {"low", "high"}:
+            raise _core.ScenarioParseError(f"{path}: sweep.parameters.{k} must be a list of values or "
+                                           f"{{low = ..., high = ...}}, got the keys {sorted(spec)}")
         values = list(spec.values()) if isinstance(spec, dict) else spec if isinstance(spec, list) else [spec]
         bad = [v for v in values if isinstance(v, bool) or not isinstance(v, (int, float))]
         if bad:
             raise _core.ScenarioParseError(f"{path}: sweep.parameters.{k} must hold numbers, got {bad[0]!r}")
+        bad = [v for v in values if not math.isfinite(v)]
+        if bad:
+            raise _core.InvalidInputError(f"{path}: sweep.parameters.{k} must hold finite numbers, got {bad[0]!r}")
+        if isinstance(spec, dict) and not spec["low"] <= spec["high"]:
+            raise _core.InvalidInputError(f"{path}: sweep.parameters.{k} must have low <= high, got low = "
+                                          f"{spec['low']!r}, high = {spec['high']!r}")
+        if len(values) > MAX_CASES:
+            raise _core.InvalidInputError(f"{path}: sweep.parameters.{k} lists {len(values)} values; at most "
+                                          f"{MAX_CASES}")
     if mode == "grid":
+        n_grid = math.prod(len(params[k]) if isinstance(params[k], list) else 1 for k in keys)
+        if n_grid > MAX_CASES:
+            raise _core.InvalidInputError(f"{path}: the grid has {n_grid} cases; at most {MAX_CASES} "
+                                          "(split the sweep, or sample it: mode = \"random\")")
         for k in keys:
             if not isinstance(params[k], list) or not params[k]:
                 raise _core.ScenarioParseError(f"{path}: in grid mode, sweep.parameters.{k} must be a list of values")
         cases = [dict(zip(keys, map(float, combo))) for combo in itertools.product(*(params[k] for k in keys))]
     elif mode == "random":
         n = sw.get("samples")
-        if not isinstance(n, int) or n < 1:
-            raise _core.ScenarioParseError(f"{path}: random mode needs sweep.samples, an integer >= 1")
-        rng = np.random.default_rng(sw.get("seed", 0))
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_CASES:
+            raise _core.ScenarioParseError(f"{path}: random mode needs sweep.samples, an integer from 1 to "
+                                           f"{MAX_CASES}, got {n!r}")
+        seed = sw.get("seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
+            raise _core.ScenarioParseError(f"{path}: sweep.seed must be an integer from 0 to 2^63 - 1, got {seed!r}")
+        rng = np.random.default_rng(seed)
         cases = [{} for _ in range(n)]
         for k in keys:
             spec = params[k]
@@ -339,8 +367,6 @@ def load_sweep(path: str) -> Sweep:
                     f"{path}: sweep.parameters.{k} must be {{low = ..., high = ...}} or a list in random mode")
             for c, v in zip(cases, vals):
                 c[k] = float(v)
-    else:
-        raise _core.ScenarioParseError(f"{path}: sweep.mode must be 'grid' or 'random', got {mode!r}")
     return Sweep(settings=settings, base=sc.vessel, cases=cases,
                  name=os.path.splitext(os.path.basename(path))[0])
 
@@ -407,28 +433,104 @@ def _run_cases(base_tables: dict, settings: Settings, cases: list[dict], store: 
     return results
 
 
+#: Most worker processes of a local cluster.
+MAX_WORKERS = 512
+
+#: Seconds to wait for a scheduler given by address to accept a connection.
+CONNECT_TIMEOUT = 3.0
+
+
+def check_cluster(scheduler: str | None = None, n_workers: int | None = None) -> None:
+    """Refuse cluster arguments that cannot work, before anything is written or started: a
+    worker count that is not an integer from 1 to :data:`MAX_WORKERS`, a worker count with a
+    scheduler (whose workers are its own), and a scheduler address that is malformed or where
+    nothing accepts a connection within :data:`CONNECT_TIMEOUT` seconds."""
+    import socket
+    from urllib.parse import urlsplit
+
+    if n_workers is not None:
+        if isinstance(n_workers, bool) or not isinstance(n_workers, (int, np.integer)) or not (
+                1 <= n_workers <= MAX_WORKERS):
+            raise _core.InvalidInputError(f"workers must be an integer from 1 to {MAX_WORKERS} (processes of the "
+                                          f"local cluster), got {n_workers!r}")
+        if scheduler is not None:
+            raise _core.InvalidInputError("give workers (a local cluster) or a scheduler (an existing cluster, "
+                                          "with its own workers), not both")
+    if scheduler is None:
+        return
+    if not isinstance(scheduler, str) or not scheduler.strip():
+        raise _core.InvalidInputError(f"scheduler must be an address like tcp://host:8786, got {scheduler!r}")
+    addr = scheduler if "://" in scheduler else "tcp://" + scheduler
+    if addr.startswith("inproc://"):
+        return  # a scheduler in this process (a LocalCluster with processes=False): the client finds it or fails at once
+    try:
+        u = urlsplit(addr)
+        host, port = u.hostname, u.port
+    except ValueError:
+        host = port = None
+    if u.scheme not in ("tcp", "tls", "ws", "wss") or not host or port is None or u.path not in ("", "/"):
+        raise _core.InvalidInputError(f"scheduler must be an address like tcp://host:8786 (tcp, tls, ws or wss, a host "
+                                      f"and a port), got {scheduler!r}")
+    deadline = time.monotonic() + CONNECT_TIMEOUT
+    try:
+        with socket.create_connection((host, port), timeout=CONNECT_TIMEOUT) as sock:
+            if u.scheme == "tcp":
+                # A Dask server greets a new connection with its handshake: a frame whose 8-byte
+                # little-endian length is small. Anything else does not speak Dask's protocol.
+                head = b""
+                while len(head) < 8:
+                    sock.settimeout(max(0.05, deadline - time.monotonic()))
+                    part = sock.recv(8 - len(head))
+                    if not part:
+                        break
+                    head += part
+                if len(head) < 8 or not 0 < int.from_bytes(head, "little") < 2**20:
+                    raise _core.InvalidInputError(
+                        f"the address {scheduler!r} answers, but not as a dask scheduler (its greeting is not "
+                        "Dask's); give the address the scheduler prints (e.g. tcp://host:8786)")
+    except OSError as e:
+        why = "no answer" if isinstance(e, TimeoutError) else (e.strerror or str(e))
+        raise _core.InvalidInputError(f"cannot reach the scheduler {scheduler!r}: {why} within "
+                                      f"{CONNECT_TIMEOUT:g} s (is a dask scheduler running there?)") from None
+
+
 def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers: int | None = None,
               progress: bool = True, retries: int = 3) -> dict[str, Any]:
     """Run the missing cases of ``sweep`` on Dask and store them; returns counts and the summary
-    table path."""
+    table path. The cluster arguments are checked (:func:`check_cluster`) before the store is
+    touched."""
     from dask.distributed import Client, LocalCluster, as_completed
     from tqdm import tqdm
 
-    os.makedirs(os.path.join(store, "cases"), exist_ok=True)
-    remove_temporaries(store)  # left by a client that was killed mid-write
+    if not isinstance(sweep, Sweep):
+        raise _core.InvalidInputError(f"sweep must be a phsplit.batch.Sweep, got {type(sweep).__name__}")
+    check_cluster(scheduler, n_workers)
+    if os.path.exists(store) and not os.path.isdir(store):
+        raise _core.InvalidInputError(f"the store {store!r} is a file, not a folder")
     ids = [sweep.case_id(i) for i in range(len(sweep.cases))]
     have = done_cases(store)  # cases of other settings stay in the store under their own ids, unused
     todo = [i for i, cid in enumerate(ids) if cid not in have]
     workers = n_workers or os.cpu_count() or 2
-    write_sweep_file(store, {"name": sweep.name, **sweep.identity(), "cases": dict(zip(ids, sweep.cases))})
-    cluster = None
+    cluster = client = None
+    if todo and scheduler:  # connected before the store is touched: an address that fails writes nothing
+        try:
+            client = Client(scheduler, set_as_default=False, timeout=CONNECT_TIMEOUT + 2.0)
+        except Exception as e:  # noqa: BLE001 - whatever the connection raised, one line
+            raise _core.InvalidInputError(f"cannot connect to the scheduler {scheduler!r}: "
+                                          f"{type(e).__name__}: {str(e)[:200]}") from None
+    try:
+        os.makedirs(os.path.join(store, "cases"), exist_ok=True)
+        remove_temporaries(store)  # left by a client that was killed mid-write
+        write_sweep_file(store, {"name": sweep.name, **sweep.identity(), "cases": dict(zip(ids, sweep.cases))})
+    except BaseException:
+        if client is not None:
+            client.close()
+        raise
     rows: dict[str, dict] = {}  # the summary rows of the cases computed now
     lost: list[str] = []  # cases whose task failed outside the case: not stored
     t0 = time.perf_counter()
     if todo:
-        if scheduler:
-            client = Client(scheduler, set_as_default=False)
-        else:
+        if client is None:
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1,
                                    processes=True, host="127.0.0.1", dashboard_address=None)
             client = Client(cluster, set_as_default=False)

@@ -290,6 +290,7 @@ def _simulate(args) -> int:
     out = args.out
     # Validate everything (and learn the step count) before any file is touched.
     n = sc.settings.checked()["n_steps"]
+    _first_step(sc)
     try:
         os.makedirs(out, exist_ok=True)
     except OSError as e:
@@ -400,6 +401,27 @@ def _simulate(args) -> int:
     return 0
 
 
+def _first_step(sc) -> None:
+    """Run the scenario's first step, before any file is touched: what the core refuses only
+    when a run starts (a method the vessel's components cannot take) or what fails at once (a
+    force that cannot be evaluated at the initial state) is then a usage error, with nothing
+    written."""
+    import dataclasses
+    import warnings
+
+    import phsplit
+
+    t0 = sc.t_span[0]
+    probe = dataclasses.replace(sc.settings, t_span=(t0, t0 + sc.h), save_every=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the run itself warns, once
+        sol = phsplit.simulate(sc.vessel, settings=probe)
+    if sol.status == "interrupted":  # the core returned on a signal: the user asked to stop
+        raise KeyboardInterrupt
+    if sol.status == "failed":
+        raise UsageError(f"the run fails at its first step, so nothing was started: {sol.failure}")
+
+
 def _seconds_since_start() -> float:
     """Wall-clock seconds since this process started (Linux: from /proc, so the interpreter's own
     start-up counts too), else since phsplit was imported."""
@@ -465,14 +487,24 @@ def _reproduce(args) -> int:
 
 
 def _sweep(args) -> int:
-    from .batch import load_sweep, run_sweep
+    import phsplit
+
+    from .batch import check_cluster, load_sweep, run_sweep
 
     sw = load_sweep(args.sweep)
-    store = args.out or os.path.splitext(args.sweep)[0] + ".store"
     try:
-        os.makedirs(store, exist_ok=True)
-    except OSError as e:
-        raise UsageError(f"cannot create the store {store!r}: {e.strerror}") from None
+        check_cluster(args.scheduler, args.workers)
+    except phsplit.InvalidInputError as e:
+        raise UsageError(str(e).replace("workers must", "--workers must").replace("scheduler must", "--scheduler must")
+                         .replace("give workers", "give --workers").replace("or a scheduler", "or --scheduler")) from None
+    store = args.out or os.path.splitext(args.sweep)[0] + ".store"
+    if os.path.exists(store) and not os.path.isdir(store):
+        raise UsageError(f"the store {store!r} is a file, not a folder (--out names a folder)")
+    parent = store
+    while not os.path.exists(parent):
+        parent = os.path.dirname(os.path.abspath(parent))
+    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+        raise UsageError(f"cannot create the store {store!r}: {parent!r} is not a writable folder")
     print(f"sweep {sw.name}: {len(sw.cases)} cases, {sw.settings.method} h={sw.settings.h:g} s on "
           f"[{sw.settings.t_span[0]:g}, {sw.settings.t_span[1]:g}] s; store {os.path.abspath(store)}", flush=True)
     res = run_sweep(sw, store, scheduler=args.scheduler, n_workers=args.workers,
@@ -493,8 +525,22 @@ def _sweep(args) -> int:
 
 def _rerun(args) -> int:
     from .files import publish
-    from .results import compare, open_dataset, rerun
+    from .results import check_record, compare, open_dataset, rerun
 
+    dest = None
+    if args.out:  # where the rerun goes, checked before it is computed
+        if os.path.exists(args.out) and not os.path.isdir(args.out):
+            raise UsageError(f"--out names a folder to write the rerun into, but {args.out!r} is a file")
+        dest = os.path.join(args.out, os.path.basename(args.file))
+        if os.path.isdir(dest):
+            raise UsageError(f"cannot write the rerun to {dest!r}: a folder of that name is in the way")
+        if os.path.exists(dest) and os.path.samefile(dest, args.file):
+            raise UsageError(f"--out {args.out!r} would overwrite {args.file!r} with its rerun; choose another folder")
+        parent = args.out
+        while not os.path.exists(parent):
+            parent = os.path.dirname(os.path.abspath(parent))
+        if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+            raise UsageError(f"cannot create --out {args.out!r}: {parent!r} is not a writable folder")
     ds = open_dataset(args.file)
     if "case" in ds.dims:
         ds.close()
@@ -505,6 +551,11 @@ def _rerun(args) -> int:
         raise UsageError(f"{args.file!r} holds no run to repeat (no time dimension; a sweep summary or a case "
                          "that did not run)")
     try:
+        check_record(ds)
+    except BaseException:
+        ds.close()
+        raise
+    try:
         t0 = time.perf_counter()
         print(f"rerunning {args.file}: phsplit {ds.attrs.get('phsplit_version')} {ds.attrs.get('method')} "
               f"h={ds.attrs.get('step_size_s')} s, {ds.sizes['time']} saved states, status "
@@ -513,9 +564,11 @@ def _rerun(args) -> int:
         diffs = compare(ds, again)
     finally:
         ds.close()
-    if args.out:
-        os.makedirs(args.out, exist_ok=True)
-        dest = os.path.join(args.out, os.path.basename(args.file))
+    if dest is not None:
+        try:
+            os.makedirs(args.out, exist_ok=True)
+        except OSError as e:
+            raise UsageError(f"cannot create --out {args.out!r}: {e.strerror}") from None
         fd, tmp = tempfile.mkstemp(dir=args.out, prefix=".rerun-", suffix=".nc")
         os.close(fd)
         try:
@@ -536,7 +589,7 @@ def _rerun(args) -> int:
 
 
 def _plot(args) -> int:
-    from .plotting import plot_dp
+    from .plotting import check_plottable, plot_dp
     from .results import open_dataset
 
     if args.watch_circle is not None and not (args.watch_circle > 0 and args.watch_circle < 1e6):
@@ -547,6 +600,12 @@ def _plot(args) -> int:
     d = os.path.dirname(os.path.abspath(out))
     if not os.path.isdir(d):
         raise UsageError(f"the folder of --out does not exist: {d!r}")
+    if os.path.isdir(out):
+        raise UsageError(f"--out {out!r} is a folder; name the image to write (.png, .pdf or .svg)")
+    if os.path.exists(out) and os.path.exists(args.file) and os.path.samefile(out, args.file):
+        raise UsageError(f"--out {out!r} would overwrite the result file itself")
+    if not os.access(d, os.W_OK | os.X_OK):
+        raise UsageError(f"the folder of --out is not writable: {d!r}")
     with open_dataset(args.file) as ds:
         if "position" not in ds or "euler" not in ds:
             raise UsageError(f"{args.file!r} holds no trajectory (it is not a run's file)")
@@ -554,6 +613,7 @@ def _plot(args) -> int:
             raise UsageError(f"{args.file!r} holds cases of a sweep (a batch file of a sweep store), not one run; "
                              "plot one case in Python: phsplit.plotting.plot_dp(phsplit.results.sweep_case("
                              "STORE, CASE_ID), OUT)")
+        check_plottable(ds, args.file)
         plot_dp(ds, out, watch_circle=args.watch_circle)
     print(f"wrote {os.path.abspath(out)}")
     return 0

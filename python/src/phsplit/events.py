@@ -60,6 +60,11 @@ class Event:
     terminal: bool = True
 
     def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise _core.InvalidInputError(f"an event's name must be a non-empty string, got {self.name!r}")
+        if not isinstance(self.terminal, (bool, np.bool_)):
+            raise _core.InvalidInputError(f"event {self.name!r}: terminal must be True or False, got "
+                                          f"{self.terminal!r}")
         if self.direction not in ("both", "rise", "fall"):
             raise _core.InvalidInputError(f"event {self.name!r}: direction must be 'both', 'rise' or 'fall', "
                                           f"got {self.direction!r}")
@@ -103,6 +108,7 @@ def watch_circle(radius: float, direction: str = "leave", terminal: bool = True)
     ``direction="leave"`` (outward, the alarm), ``"enter"`` or ``"both"``. With a moving set
     point (``[setpoint]``) the circle moves with the desired position of the reference model."""
     r = _positive("watch_circle", "radius (m)", radius)
+    _terminal("watch_circle", terminal)
     if direction not in ("leave", "enter", "both"):
         raise _core.InvalidInputError(f"watch_circle: direction must be 'leave', 'enter' or 'both', got {direction!r}")
     cache: dict[int, tuple[Any, np.ndarray]] = {}
@@ -122,8 +128,24 @@ def watch_circle(radius: float, direction: str = "leave", terminal: bool = True)
     return Event(f"watch_circle_{r:g}m_{direction}", g, d, terminal)
 
 
+def _terminal(name: str, terminal) -> bool:
+    if not isinstance(terminal, (bool, np.bool_)):
+        raise _core.InvalidInputError(f"{name}: terminal must be True or False, got {terminal!r}")
+    return bool(terminal)
+
+
+#: The largest |roll| and |pitch| an Euler angle (ZYX) can reach, degrees: an event beyond it never fires.
+ANGLE_LIMITS = {"roll_beyond": 180.0, "pitch_beyond": 90.0}
+
+
 def _angle_event(which: int, label: str, limit_deg: float, terminal: bool) -> Event:
-    lim = math.radians(_positive(label, "limit (degrees)", limit_deg))
+    lim_deg = _positive(label, "limit (degrees)", limit_deg)
+    top = ANGLE_LIMITS[label]
+    if lim_deg >= top:
+        raise _core.InvalidInputError(f"{label}: limit (degrees) must be below {top:g} (|{label.split('_')[0]}| "
+                                      f"never exceeds {top:g} degrees, so the event could never fire), got {limit_deg!r}")
+    lim = math.radians(lim_deg)
+    _terminal(label, terminal)
 
     def g(t, y, vessel):
         q = y[6:15].reshape(3, 3, order="F")
@@ -146,6 +168,7 @@ def pitch_beyond(degrees: float, terminal: bool = True) -> Event:
 def energy_above(joules: float, terminal: bool = True) -> Event:
     """The stored energy H rises above ``joules``."""
     e_max = _positive("energy_above", "energy (J)", joules)
+    _terminal("energy_above", terminal)
     return Event(f"energy_above_{e_max:g}J", lambda t, y, vessel: vessel.energy(y) - e_max, "rise", terminal)
 
 
@@ -157,6 +180,10 @@ _FIELDS = ("x", "euler", "quaternion", "Q", "p", "m", "mu", "phi_th", "phi_x", "
 
 
 def _check_times(save_at, t0: float, t1: float) -> np.ndarray:
+    items = save_at if isinstance(save_at, (list, tuple)) else [save_at]
+    if isinstance(save_at, (str, bytes)) or any(isinstance(x, (bool, np.bool_, str, bytes)) for x in items) or (
+            isinstance(save_at, np.ndarray) and save_at.dtype.kind not in "fiu"):
+        raise _core.InvalidInputError(f"save_at must be a sequence of times (s), numbers, got {save_at!r}")
     try:
         ts = np.asarray(save_at, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -197,6 +224,9 @@ def _call(vessel, settings, t_a, t_b, h, y, save_every):
 
 def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event] = ()):
     """``simulate`` with ``save_at`` or ``events`` (see the module documentation)."""
+    if isinstance(events, Event) or not isinstance(events, (list, tuple, type(None))):
+        raise _core.InvalidInputError(f"events must be a list of phsplit.events.Event objects, got "
+                                      f"{type(events).__name__}")
     events = list(events or ())
     for ev in events:
         if not isinstance(ev, Event):
@@ -209,6 +239,17 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
     t0, t1 = settings.t_span
     h = float(settings.h)
     y = np.array(vessel.initial_state() if y0 is None else y0, dtype=float)
+    if save_at is not None:
+        _check_times(save_at, t0, t1)
+    for ev in events:  # a condition that cannot be evaluated would never fire, silently
+        try:
+            g0 = ev.g(float(t0), y.copy(), vessel)
+        except Exception as e:  # noqa: BLE001 - the user's function: its failure is reported by name
+            raise _core.InvalidInputError(f"event {ev.name!r}: g(t0, y0, vessel) raised {type(e).__name__}: {e}") from None
+        if isinstance(g0, (bool, np.bool_)) or not isinstance(g0, (int, float, np.integer, np.floating)) or not (
+                math.isfinite(g0)):
+            raise _core.InvalidInputError(f"event {ev.name!r}: g(t0, y0, vessel) must be a finite number (the event "
+                                          f"is where it crosses 0), got {g0!r} at the initial state")
     names: list[str] = list(dict(vessel.accounts))
     rows = _Rows()
     hits: list[EventHit] = []
@@ -357,7 +398,12 @@ def dense_output(sol, times):
     if not prov or "vessel_toml" not in prov:
         raise _core.InvalidInputError("this Solution does not record its vessel (it was assembled from several "
                                       "runs); rerun with save_at instead")
-    ts = np.asarray(times, dtype=float).reshape(-1)
+    if isinstance(times, (str, bytes, bool, np.bool_)):
+        raise _core.InvalidInputError(f"times must be a time or a sequence of times (s), numbers, got {times!r}")
+    try:
+        ts = np.asarray(times, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError(f"times must be a time or a sequence of times (s), numbers, got {times!r}") from None
     if ts.size == 0 or not np.all(np.isfinite(ts)) or ts.min() < sol.t[0] or ts.max() > sol.t[-1]:
         raise _core.InvalidInputError(f"times must be finite and within the run [{sol.t[0]:g}, {sol.t[-1]:g}] s")
     vessel = Vessel.from_toml_str(prov["vessel_toml"])

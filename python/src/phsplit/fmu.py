@@ -58,6 +58,48 @@ def _binary_name(plat: str) -> str:
     return MODEL_IDENTIFIER + ext
 
 
+#: What a shared library of each FMI platform is: its format and word size.
+_FORMATS = {"linux64": ("an ELF shared object", 64), "linux32": ("an ELF shared object", 32),
+            "win64": ("a Windows DLL (PE)", 64), "win32": ("a Windows DLL (PE)", 32),
+            "darwin64": ("a Mach-O dynamic library", 64)}
+
+
+def binary_problem(plat: str, data: bytes) -> str | None:
+    """Why ``data`` is not an FMU binary for FMI platform ``plat`` (``None`` if it is one): the
+    executable format and word size of the platform's shared libraries (ELF, PE, Mach-O, read
+    from the file's header) and the FMI 2.0 entry point ``fmi2Instantiate`` among its symbols."""
+    import struct
+
+    what, bits = _FORMATS[plat]
+    kind = None
+    if data[:4] == b"\x7fELF" and len(data) > 18:
+        cls = {1: 32, 2: 64}.get(data[4])
+        endian = "<" if data[5] == 1 else ">"
+        e_type = struct.unpack(endian + "H", data[16:18])[0]
+        kind = ("an ELF shared object" if e_type == 3 else "an ELF file that is not a shared object", cls)
+    elif data[:2] == b"MZ" and len(data) >= 64:
+        off = struct.unpack("<I", data[60:64])[0]
+        if data[off:off + 4] == b"PE\0\0" and len(data) >= off + 24:
+            machine, = struct.unpack("<H", data[off + 4:off + 6])
+            chars, = struct.unpack("<H", data[off + 22:off + 24])
+            cls = {0x8664: 64, 0xAA64: 64, 0x14C: 32}.get(machine)
+            kind = ("a Windows DLL (PE)" if chars & 0x2000 else "a Windows program (PE) that is not a DLL", cls)
+    elif data[:4] in (b"\xcf\xfa\xed\xfe", b"\xce\xfa\xed\xfe") and len(data) >= 16:
+        filetype, = struct.unpack("<I", data[12:16])
+        kind = ("a Mach-O dynamic library" if filetype in (6, 8) else "a Mach-O file that is not a library",
+                64 if data[0] == 0xCF else 32)
+    elif data[:4] == b"\xca\xfe\xba\xbe":
+        kind = ("a Mach-O dynamic library", 64)  # a universal binary: its slices hold the word size
+    if kind is None:
+        return f"is not a shared library (not ELF, PE or Mach-O); a {plat} FMU binary must be {what}, {bits}-bit"
+    if kind[0] != what or kind[1] != bits:
+        size = f"{kind[1]}-bit " if kind[1] else ""
+        return f"is {size}{kind[0]}; a {plat} FMU binary must be {what}, {bits}-bit"
+    if b"fmi2Instantiate" not in data:
+        return "does not export the FMI 2.0 functions (no fmi2Instantiate in it): it is not an FMU binary"
+    return None
+
+
 def _binaries(extra: Mapping[str, str | os.PathLike[str]] | None) -> dict[str, bytes]:
     """The binaries to pack: the shipped one for this machine, plus ``extra`` (platform -> path)."""
     out: dict[str, bytes] = {}
@@ -69,10 +111,16 @@ def _binaries(extra: Mapping[str, str | os.PathLike[str]] | None) -> dict[str, b
         if p not in ("linux64", "linux32", "win64", "win32", "darwin64"):
             raise _core.InvalidInputError(f"binary platform must be one of linux64, linux32, win64, win32, "
                                           f"darwin64 (FMI 2.0 platform folders), got {p!r}")
+        if os.path.isdir(path):
+            raise _core.InvalidInputError(f"the {p} binary {os.fspath(path)!r} is a folder, not a shared library")
         try:
-            out[p] = Path(path).read_bytes()
+            data = Path(path).read_bytes()
         except OSError as e:
             raise _core.InvalidInputError(f"cannot read the {p} binary {os.fspath(path)!r}: {e.strerror}") from None
+        why = binary_problem(p, data)
+        if why:
+            raise _core.InvalidInputError(f"the {p} binary {os.fspath(path)!r} {why}")
+        out[p] = data
     if not out:
         raise _core.PhsplitError(
             f"no FMU binary for this platform ({plat}, {platform.machine()}): the package ships "

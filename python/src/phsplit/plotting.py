@@ -5,6 +5,7 @@ import os
 
 import numpy as np
 
+from . import _core
 from .files import publish, temporary_beside
 
 
@@ -53,6 +54,40 @@ def reference_of(vessel) -> dict:
     c = vessel.to_dict()["control"]
     xr, er = np.asarray(c["position_reference"]), np.asarray(c["euler_reference"])
     return {"x": xr[0], "y": xr[1], "z": xr[2], "roll": er[0], "pitch": er[1], "yaw": er[2]}
+
+
+#: The variables the DP figure needs, with their dimensions beyond time and the sizes there.
+NEEDED = {"position": 3, "euler": 3, "energy": None}
+
+
+def check_plottable(ds, where: str = "the result") -> None:
+    """Refuse a result the DP figure cannot be drawn from, naming what is missing or damaged:
+    a time axis, the variables of :data:`NEEDED` along it (a vector of the stated size at each
+    time), and a readable vessel record (``phsplit_vessel``) if it has one."""
+    import tomllib
+
+    if "time" not in ds.dims or ds.sizes["time"] < 1:
+        raise _core.InvalidInputError(f"{where!r} holds no run to plot (no saved times)")
+    for name, width in NEEDED.items():
+        if name not in ds:
+            raise _core.InvalidInputError(f"{where!r} has no {name!r} variable, which the DP figure needs "
+                                          f"(it needs {', '.join(NEEDED)})")
+        v = ds[name]
+        shape_ok = v.dims[:1] == ("time",) and (v.ndim == 1 if width is None else v.ndim == 2 and v.shape[1] == width)
+        if not shape_ok or v.dtype.kind not in "fiu":
+            want = "one number" if width is None else f"{width} numbers"
+            raise _core.InvalidInputError(f"{where!r}: the variable {name!r} is damaged: it must hold {want} at each "
+                                          f"time, got dims {v.dims} and type {v.dtype}")
+    if "phsplit_vessel" in ds.attrs:
+        try:
+            c = tomllib.loads(str(ds.attrs["phsplit_vessel"])).get("control")
+            if c:
+                for k in ("position_reference", "euler_reference"):
+                    if np.asarray(c[k], dtype=float).shape != (3,):
+                        raise ValueError(k)
+        except (tomllib.TOMLDecodeError, KeyError, TypeError, ValueError, AttributeError):
+            raise _core.InvalidInputError(f"{where!r}: the phsplit_vessel attribute is damaged (not a vessel file "
+                                          "with its [control] set point)") from None
 
 
 def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None = None) -> None:

@@ -37,7 +37,8 @@ from .vessel import Vessel
 #: The CF finishing of a dataset (:func:`phsplit.cf.finish`), under its earlier name.
 cf_finish = cf.finish
 
-__all__ = ["open_dataset", "open_sweep", "sweep_case", "rerun", "compare", "run_chunks", "settings_of", "vessel_of", "cf_finish"]
+__all__ = ["open_dataset", "open_sweep", "sweep_case", "rerun", "compare", "run_chunks", "settings_of", "vessel_of", "cf_finish",
+           "check_record"]
 
 
 def _need(ds, key: str) -> str:
@@ -48,19 +49,102 @@ def _need(ds, key: str) -> str:
     return ds.attrs[key]
 
 
+def _damaged(key: str, why: str) -> _core.InvalidInputError:
+    return _core.InvalidInputError(f"the file's {key} attribute is damaged: {why}; it cannot be rerun")
+
+
 def vessel_of(ds) -> Vessel:
     """The vessel a result was computed with."""
-    return Vessel.from_toml_str(_need(ds, "phsplit_vessel"))
+    text = _need(ds, "phsplit_vessel")
+    if not isinstance(text, str):
+        raise _damaged("phsplit_vessel", f"it must be a vessel file (TOML text), got {type(text).__name__}")
+    try:
+        return Vessel.from_toml_str(text)
+    except (_core.InvalidInputError, _core.ScenarioParseError) as e:
+        raise _damaged("phsplit_vessel", str(e)) from None
+
+
+#: The keys of the ``[simulation]`` table of ``phsplit_settings`` and the types they hold.
+_SETTINGS_TYPES = {"t_span": list, "h": (int, float), "method": str, "outer": str, "save_every": int,
+                   "linear_flow": str, "ledger": bool}
 
 
 def settings_of(ds) -> Settings:
-    """The settings a result was computed with."""
-    sim = tomllib.loads(_need(ds, "phsplit_settings"))["simulation"]
+    """The settings a result was computed with (checked as a run's are)."""
+    text = _need(ds, "phsplit_settings")
+    if not isinstance(text, str):
+        raise _damaged("phsplit_settings", f"it must be a [simulation] table (TOML text), got {type(text).__name__}")
+    try:
+        sim = tomllib.loads(text).get("simulation")
+    except tomllib.TOMLDecodeError as e:
+        raise _damaged("phsplit_settings", f"TOML syntax error: {e}") from None
+    if not isinstance(sim, dict):
+        raise _damaged("phsplit_settings", "it has no [simulation] table")
+    for k, typ in _SETTINGS_TYPES.items():
+        if k not in sim:
+            raise _damaged("phsplit_settings", f"simulation.{k} is missing")
+        if isinstance(sim[k], bool) and typ is not bool or not isinstance(sim[k], typ):
+            raise _damaged("phsplit_settings", f"simulation.{k} = {sim[k]!r} is not what a run records")
     cs = sim.get("control_start", "never")
-    return Settings(t_span=tuple(sim["t_span"]), h=sim["h"], method=sim["method"],
-                    control_start=None if cs == "never" else cs, outer=sim["outer"],
-                    save_every=sim["save_every"], linear_flow=sim["linear_flow"], ledger=sim["ledger"],
-                    project_invariants=sim.get("project_invariants", True))
+    if isinstance(cs, bool) or not (cs == "never" or isinstance(cs, (int, float))):
+        raise _damaged("phsplit_settings", f"simulation.control_start = {cs!r} is neither a time nor 'never'")
+    pi = sim.get("project_invariants", True)
+    if not isinstance(pi, bool):
+        raise _damaged("phsplit_settings", f"simulation.project_invariants = {pi!r} is not true or false")
+    ts = sim["t_span"]
+    if len(ts) != 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in ts):
+        raise _damaged("phsplit_settings", f"simulation.t_span = {ts!r} is not two numbers")
+    settings = Settings(t_span=(float(ts[0]), float(ts[1])), h=sim["h"], method=sim["method"],
+                        control_start=None if cs == "never" else cs, outer=sim["outer"],
+                        save_every=sim["save_every"], linear_flow=sim["linear_flow"], ledger=sim["ledger"],
+                        project_invariants=pi)
+    try:
+        settings.checked()
+    except _core.InvalidInputError as e:
+        raise _damaged("phsplit_settings", str(e)) from None
+    return settings
+
+
+def _chunks_of(ds, settings: Settings) -> list[int]:
+    """The calls the run was cut into (``phsplit_chunks``), checked against its settings."""
+    text = _need(ds, "phsplit_chunks")
+    parts = str(text).split()
+    if not parts or not all(p.isdigit() and int(p) >= 1 for p in parts):
+        raise _damaged("phsplit_chunks", f"it must be step counts >= 1 separated by spaces, got {str(text)[:60]!r}")
+    chunks = [int(c) for c in parts]
+    n = int(settings.checked()["n_steps"])
+    if sum(chunks) != n:
+        raise _damaged("phsplit_chunks", f"its step counts add up to {sum(chunks)}, but the settings make {n} steps")
+    return chunks
+
+
+def check_record(ds) -> tuple[Vessel, Settings, np.ndarray, list[int]]:
+    """What :func:`rerun` needs from a result, each part checked before anything is computed:
+    the vessel, the settings, the initial state (a finite vector of the vessel's state size) and
+    the calls (``phsplit_chunks``, adding up to the settings' steps). Raises
+    :class:`phsplit.InvalidInputError` naming the damaged part."""
+    if "case" in ds.dims:
+        raise _core.InvalidInputError(
+            f"the result holds {ds.sizes['case']} cases of a sweep (a batch file of a sweep store); rerun one "
+            "case: phsplit.results.rerun(phsplit.results.sweep_case(STORE, CASE_ID))")
+    vessel, settings = vessel_of(ds), settings_of(ds)
+    if "initial_state" not in ds:
+        raise _core.InvalidInputError("the file has no initial_state variable to start the rerun from")
+    try:
+        y0 = np.asarray(ds["initial_state"].values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError("the file's initial_state variable is damaged: it does not hold numbers") from None
+    n = _core.STATE_DIM  # and the rate-limited thrusters' memory, when the run continued one (the core checks it)
+    if y0.ndim != 1 or y0.size < n or not np.all(np.isfinite(y0)):
+        raise _core.InvalidInputError(f"the file's initial_state variable is damaged: it must be at least {n} finite "
+                                      f"numbers (the vessel's state), got shape {y0.shape}")
+    chunks = _chunks_of(ds, settings)
+    if ds.attrs.get("status") == "interrupted":
+        steps = ds.attrs.get("steps")
+        if isinstance(steps, (bool, str)) or not isinstance(steps, (int, np.integer)) or not 0 <= steps <= sum(chunks):
+            raise _core.InvalidInputError(f"the file's steps attribute is damaged: it must be the steps an "
+                                          f"interrupted run reached, 0 to {sum(chunks)}, got {steps!r}")
+    return vessel, settings, y0, chunks
 
 
 def rerun(source, progress: bool = False):
@@ -69,15 +153,7 @@ def rerun(source, progress: bool = False):
     interrupted is rerun to the step it reached. A case of a sweep's batch file: take it with
     :func:`sweep_case` first."""
     ds = open_dataset(source) if isinstance(source, (str, os.PathLike)) else source
-    if "case" in ds.dims:
-        raise _core.InvalidInputError(
-            f"the result holds {ds.sizes['case']} cases of a sweep (a batch file of a sweep store); rerun one "
-            "case: phsplit.results.rerun(phsplit.results.sweep_case(STORE, CASE_ID))")
-    vessel, settings = vessel_of(ds), settings_of(ds)
-    if "initial_state" not in ds:
-        raise _core.InvalidInputError("the file has no initial_state variable to start the rerun from")
-    y0 = np.asarray(ds["initial_state"].values, dtype=np.float64)
-    chunks = [int(c) for c in _need(ds, "phsplit_chunks").split()]
+    vessel, settings, y0, chunks = check_record(ds)
     if ds.attrs.get("status") == "interrupted":
         left, cut = int(ds.attrs["steps"]), []
         for c in chunks:

@@ -294,6 +294,14 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
                 table = hydro.from_capytaine(p, symmetric=sym, checks=checks)["waves"]
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
+            outside = _outside_directions(table.get("rao_directions", []), comps.get("directions", []))
+            if outside is not None:
+                raise _core.InvalidInputError(
+                    f"{path}: environment.waves: waves travel towards {outside:g} degrees, outside the directions of "
+                    f"the hydrodynamic dataset ({_degree_list(table['rao_directions'])}); its transfer functions "
+                    "are not extrapolated across the gap: use a dataset with that direction, change "
+                    "environment.waves.direction (or its spreading)"
+                    + ("" if sym else ", or symmetric = true for a port-starboard symmetric hull"))
         out["waves"] = {**table, **comps}
     if "wind" in env:
         try:
@@ -305,6 +313,35 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
 
 
 #: Angles the vessel file takes in radians that a scenario may give in degrees, as ``<key>_deg``.
+def _degree_list(dirs) -> str:
+    d = sorted(float(x) % 360.0 for x in dirs)
+    return ", ".join(f"{x:g}" for x in d[:12]) + (", ..." if len(d) > 12 else "") + " degrees"
+
+
+def _outside_directions(dataset, waves) -> float | None:
+    """A wave direction (degrees) that lies in a gap of the dataset's directions wider than its
+    regular spacing (where its transfer functions would be interpolated across a range it does
+    not cover), or ``None``. A dataset over the full circle has no such gap; one direction alone
+    covers only itself."""
+    import numpy as np
+
+    d = np.unique(np.round(np.mod(np.asarray(dataset, float), 360.0), 9))
+    w = np.mod(np.asarray(waves, float), 360.0)
+    if d.size == 0 or w.size == 0:
+        return None
+    if d.size == 1:
+        off = np.abs(np.remainder(w - d[0] + 180.0, 360.0) - 180.0)
+        return float(w[np.argmax(off)]) if off.max() > 1e-6 else None
+    gaps = np.diff(np.append(d, d[0] + 360.0))  # gap k from d[k] to the next direction
+    spacing = float(np.median(gaps))
+    for k in np.flatnonzero(gaps > 1.5 * spacing + 1e-9):
+        inside = np.remainder(w - d[k], 360.0)
+        hit = (inside > 1e-6) & (inside < gaps[k] - 1e-6)
+        if hit.any():
+            return float(w[np.argmax(hit)])
+    return None
+
+
 DEGREE_KEYS = (("initial", "euler"), ("control", "euler_reference"), ("setpoint", "headings"))
 
 

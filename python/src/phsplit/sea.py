@@ -40,6 +40,24 @@ def _number(v) -> bool:
 DIRECTION_KEYS = ("direction", "direction_towards", "direction_from")
 
 
+#: The physical ranges of the sea's own keys (the vessel file's are the core's,
+#: ``phsplit._core.physical_ranges``): (low, high, unit, why), both ends allowed.
+RANGES = {
+    "tp": (0.5, 40.0, "s", "no wind sea or swell peaks outside 0.5 to 40 s"),
+    "direction": (-360.0, 360.0, "degrees", "within a full turn either way"),
+    "height": (0.1, 500.0, "m", "a reference height above the sea surface, within 500 m"),
+    "length": (0.1, 500.0, "m", "no hull is longer than 500 m"),
+}
+
+
+def in_range(where: str, key: str, v) -> float:
+    """``v`` if it lies in :data:`RANGES` [key], else an InvalidInputError naming ``where.key``."""
+    lo, hi, unit, why = RANGES[key]
+    if not (_number(v) and lo <= v <= hi):
+        raise _core.InvalidInputError(f"{where}.{key} must lie within [{lo:g}, {hi:g}] ({unit}; {why}), got {v!r}")
+    return float(v)
+
+
 def direction_towards(table, where: str, default: float = 0.0) -> float:
     """The direction (degrees, towards) a table gives by one of :data:`DIRECTION_KEYS`, in
     [0, 360) for ``direction_from``; ``default`` when it gives none. Two of them, or a value
@@ -55,6 +73,9 @@ def direction_towards(table, where: str, default: float = 0.0) -> float:
     v = table[k]
     if not _number(v):
         raise _core.InvalidInputError(f"{where}.{k} must be a finite number (degrees), got {v!r}")
+    lo, hi, _, why = RANGES["direction"]
+    if not lo <= v <= hi:
+        raise _core.InvalidInputError(f"{where}.{k} must lie within [{lo:g}, {hi:g}] (degrees; {why}), got {v!r}")
     return (float(v) + 180.0) % 360.0 if k == "direction_from" else float(v)
 
 
@@ -100,6 +121,9 @@ class SeaState:
                 bad(f"{name} must be a number > 0 ({'m' if name == 'hs' else 's'}), got {v!r}")
         if self.hs < 1e-3 or self.hs > 30.0:
             bad(f"hs must lie in [0.001, 30] m (no sea on record is higher), got {self.hs!r}")
+        in_range("waves", "tp", self.tp)
+        if _number(self.direction):
+            in_range("waves", "direction", self.direction)
         if self.spectrum not in SPECTRA:
             bad(f"spectrum must be one of {', '.join(repr(s) for s in SPECTRA)}, got {self.spectrum!r}")
         if not (_number(self.gamma) and 1.0 <= self.gamma <= 10.0):
@@ -265,6 +289,9 @@ class Wind:
         _check_range("wind", self.omega_range)
         if not (_number(self.height) and self.height > 0):
             bad(f"height must be a number > 0 (m), got {self.height!r}")
+        in_range("wind", "height", self.height)
+        if _number(self.direction):
+            in_range("wind", "direction", self.direction)
         if not (_number(self.drag) and self.drag > 0):
             bad(f"drag must be a number > 0 (the Harris surface drag coefficient), got {self.drag!r}")
 
@@ -335,6 +362,7 @@ def wind(table: dict) -> tuple[dict, dict]:
         if not (all(_number(x) for x in dims) and all(x > 0 for x in dims[:3])):
             raise _core.InvalidInputError("environment.wind: frontal_area, lateral_area and length must be numbers "
                                           f"> 0 (m^2, m^2, m) and centroid_x a number (m), got {dims}")
+        in_range("environment.wind", "length", dims[2])
         rest.update(blendermann(str(table["ship_type"]), *dims))
     return Wind(**kw).realise(), rest
 

@@ -88,6 +88,9 @@ def simulate(
     """
     if not isinstance(vessel, Vessel):
         raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
+    for name, flag in (("orthonormalize", orthonormalize), ("running_max", running_max)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise _core.InvalidInputError(f"{name} must be True or False, got {flag!r}")
     if settings is None:
         settings = Settings(t_span=t_span, h=h, method=method, control_start=control_start, outer=outer,
                             save_every=save_every, linear_flow=linear_flow, ledger=ledger,

@@ -21,6 +21,133 @@ pub enum Range {
     Finite,
     Positive,
     NonNegative,
+    /// A physical range: what any vessel or sea can have (the named ranges below).
+    Physical(&'static Physical),
+}
+
+/// A physical range of a length, angle or time key, with why it is where it is: a value beyond
+/// it is no vessel's or sea's, but a slip (a unit, a digit), and is refused by name.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Physical {
+    pub lo: f64,
+    pub hi: f64,
+    /// Whether `lo` and `hi` themselves are allowed.
+    pub lo_closed: bool,
+    pub hi_closed: bool,
+    /// Why the range is where it is (quoted in the error).
+    pub why: &'static str,
+}
+
+impl Eq for Physical {}
+
+impl Physical {
+    pub fn contains(&self, v: f64) -> bool {
+        (if self.lo_closed {
+            v >= self.lo
+        } else {
+            v > self.lo
+        }) && (if self.hi_closed {
+            v <= self.hi
+        } else {
+            v < self.hi
+        })
+    }
+
+    pub fn interval(&self) -> String {
+        format!(
+            "{}{}, {}{}",
+            if self.lo_closed { "[" } else { "(" },
+            self.lo,
+            self.hi,
+            if self.hi_closed { "]" } else { ")" }
+        )
+    }
+}
+
+/// The physical ranges, in one place (listed in docs/reference/toml.md). Each is wide enough
+/// for every vessel and sea, and narrow enough to catch a value in the wrong unit.
+pub mod physical {
+    use super::Physical;
+
+    /// A hull's length (m): the longest ships ever built are under 460 m.
+    pub const HULL_LENGTH: Physical = Physical {
+        lo: 0.0,
+        hi: 500.0,
+        lo_closed: false,
+        hi_closed: true,
+        why: "no hull is longer than 500 m",
+    };
+    /// A hull's beam (m): the widest hulls (crane vessels, semi-submersibles) are under 130 m.
+    pub const HULL_BEAM: Physical = Physical {
+        lo: 0.0,
+        hi: 150.0,
+        lo_closed: false,
+        hi_closed: true,
+        why: "no hull is wider than 150 m",
+    };
+    /// A draught (m): the deepest-draught ships float at under 35 m.
+    pub const DRAFT: Physical = Physical {
+        lo: 0.0,
+        hi: 40.0,
+        lo_closed: false,
+        hi_closed: true,
+        why: "no ship draws more than 40 m",
+    };
+    /// A water depth (m): the deepest ocean (the Challenger Deep) is under 11 km.
+    pub const WATER_DEPTH: Physical = Physical {
+        lo: 0.0,
+        hi: 11000.0,
+        lo_closed: false,
+        hi_closed: true,
+        why: "no sea is deeper than 11000 m",
+    };
+    /// A heading or attitude angle in radians: within a full turn either way. A value beyond it
+    /// is a heading in degrees.
+    pub const ANGLE_RAD: Physical = Physical {
+        lo: -std::f64::consts::TAU,
+        hi: std::f64::consts::TAU,
+        lo_closed: true,
+        hi_closed: true,
+        why: "radians, within a full turn (±2π); a larger value is an angle in degrees",
+    };
+    /// A direction in degrees: within a full turn either way.
+    pub const ANGLE_DEG: Physical = Physical {
+        lo: -360.0,
+        hi: 360.0,
+        lo_closed: true,
+        hi_closed: true,
+        why: "degrees, within a full turn either way",
+    };
+    /// A pipe's departure angle from the horizontal (degrees): below 5° the catenary's
+    /// suspended span is over 20 times the water depth (and its tension beyond any lay
+    /// vessel's); 90° is a vertical pipe, whose lay direction is undefined.
+    pub const DEPARTURE_ANGLE: Physical = Physical {
+        lo: 5.0,
+        hi: 90.0,
+        lo_closed: true,
+        hi_closed: false,
+        why: "a pipe flatter than 5° spans over 20 water depths",
+    };
+    /// A time of an operation's schedule (s): within about 30 years of t = 0.
+    pub const TIME: Physical = Physical {
+        lo: -1e9,
+        hi: 1e9,
+        lo_closed: true,
+        hi_closed: true,
+        why: "within 1e9 s (about 30 years) of t = 0",
+    };
+
+    /// Every named range, for the documentation.
+    pub const ALL: [(&str, &str, Physical); 8] = [
+        ("hull length", "m", HULL_LENGTH),
+        ("hull beam", "m", HULL_BEAM),
+        ("draught", "m", DRAFT),
+        ("water depth", "m", WATER_DEPTH),
+        ("angle in radians", "rad", ANGLE_RAD),
+        ("angle in degrees", "degrees", ANGLE_DEG),
+        ("pipe departure angle", "degrees", DEPARTURE_ANGLE),
+        ("schedule time", "s", TIME),
+    ];
 }
 
 impl Range {
@@ -30,15 +157,29 @@ impl Range {
                 Range::Finite => true,
                 Range::Positive => v > 0.0,
                 Range::NonNegative => v >= 0.0,
+                Range::Physical(r) => r.contains(v),
             };
         if ok {
             return Ok(());
+        }
+        if let (Range::Physical(r), true) = (self, v.is_finite()) {
+            if r.lo == 0.0 && !r.lo_closed && v <= 0.0 {
+                // A positive quantity: said as every other positive key says it.
+                return Err(Error::InvalidInput(format!(
+                    "{name} must be > 0 ({unit}), got {v}"
+                )));
+            }
+            return Err(Error::InvalidInput(format!(
+                "{name} must lie within {} ({unit}; {}), got {v}",
+                r.interval(),
+                r.why
+            )));
         }
         let what = match self {
             _ if !v.is_finite() => "finite",
             Range::Positive => "> 0",
             Range::NonNegative => "≥ 0",
-            Range::Finite => "finite",
+            Range::Finite | Range::Physical(_) => "finite",
         };
         Err(Error::InvalidInput(format!(
             "{name} must be {what} ({unit}), got {v}"
@@ -297,6 +438,20 @@ impl Params {
         Ok(got)
     }
 
+    /// One of `allowed`, required (for a choice whose default would be a guess).
+    pub fn required_choice(
+        &mut self,
+        section: &str,
+        key: &str,
+        allowed: &[&'static str],
+    ) -> Result<&'static str> {
+        if self.raw(section, key)?.is_none() {
+            let what = format!("one of {}", quoted(allowed));
+            return Err(self.missing(section, key, &what));
+        }
+        self.choice(section, key, allowed)
+    }
+
     /// A required key is absent: a misspelling of it is named as such, else it is missing.
     pub fn missing(&self, section: &str, key: &str, unit: &str) -> Error {
         if let Some(Value::Table(t)) = self.input.get(section) {
@@ -443,6 +598,46 @@ mod tests {
         assert!(e.to_string().contains("3 numbers"));
         let e = Params::parse("[a\n").unwrap_err().to_string();
         assert!(e.contains("line") && e.contains("column"), "{e}");
+    }
+
+    #[test]
+    fn physical_ranges_name_the_interval_and_why() {
+        let mut p = Params::parse("[a]\nd = 5000\nok = 4.5\nk = 1\n").unwrap();
+        let e = p
+            .f64("a", "d", "m", Range::Physical(&physical::DRAFT))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "a.d must lie within (0, 40] (m; no ship draws more than 40 m), got 5000"
+        );
+        assert_eq!(
+            p.f64("a", "ok", "m", Range::Physical(&physical::DRAFT))
+                .unwrap(),
+            4.5
+        );
+        let e = p
+            .required_choice("a", "kind", &["tunnel", "azimuth"])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("missing field `kind`") && e.contains("'tunnel'"),
+            "{e}"
+        );
+        let e = p
+            .f64("a", "d", "m", Range::Physical(&physical::DRAFT))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("must lie within (0, 40]"), "{e}");
+        let mut q = Params::parse("[a]\nd = -1\n").unwrap();
+        let e = q
+            .f64("a", "d", "m", Range::Physical(&physical::WATER_DEPTH))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "a.d must be > 0 (m), got -1");
+        for (name, _, r) in physical::ALL {
+            assert!(r.lo < r.hi && !r.why.is_empty(), "{name}");
+        }
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! draught `T` and the 2-D drag coefficient `C_d` constant along it (Fossen takes `C_d` from
 //! Hoerner's curve of `B/(2T)`; give the value), `v_r` the sway velocity relative to the water.
 //!
-//! Table `[crossflow_drag]` (optional): `draft` (m, > 0), `drag_coefficient` (> 0, ≤ 5),
+//! Table `[crossflow_drag]` (optional): `draft` (m, in (0, 40], `params::physical::DRAFT`), `drag_coefficient` (> 0, ≤ 5),
 //! `x_aft`, `x_fore` (m, body x of the hull's ends, `x_aft < x_fore`, within ±1000 m). The water
 //! density is the vessel's (`vessel.water_density`).
 //!
@@ -35,7 +35,7 @@ use super::current::Current;
 use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::solve::Account;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
@@ -59,7 +59,7 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
     if !p.has(T) {
         return Ok(None);
     }
-    let draft = p.f64(T, "draft", "m", Range::Positive)?;
+    let draft = p.f64(T, "draft", "m", Range::Physical(&physical::DRAFT))?;
     let cd = p.f64(
         T,
         "drag_coefficient",

@@ -35,7 +35,7 @@ use super::{Force, Forcing, Frozen, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::grid::check_increasing;
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::solve::Account;
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -141,7 +141,7 @@ pub fn read(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Current
     if !p.has(T) {
         return Ok(None);
     }
-    let times = p.rows(T, "times", 1, "s", Range::Finite)?;
+    let times = p.rows(T, "times", 1, "s", Range::Physical(&physical::TIME))?;
     let rows = p.rows(T, "velocities", 3, "m/s, spatial frame", Range::Finite)?;
     let table = match (times, rows) {
         (None, None) => None,

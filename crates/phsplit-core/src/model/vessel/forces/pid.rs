@@ -18,7 +18,7 @@
 //! `control.euler_reference`; the table moves the position and the heading). Keys:
 //! - `natural_frequency` ω (rad/s, > 0) and `relative_damping` ζ (> 0, default 1: critically
 //!   damped, the filter's step response does not overshoot);
-//! - `positions` (rows of 3 numbers, m, spatial) and optionally `headings` (rad, yaw), one per
+//! - `positions` (rows of 3 numbers, m, spatial) and optionally `headings` (rad, yaw, within ±2π: `physical::ANGLE_RAD`), one per
 //!   row (each turns the short way from the one before: a turn of more than half a circle
 //!   needs rows in between), with either `times` (s, increasing) or `speed` (m/s, > 0, the rows are waypoints
 //!   passed at this speed from `start_time`, s, default 0);
@@ -35,7 +35,7 @@ use super::{Force, Forcing, Frozen, Output, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::reference::{Interpolation, Reference, CHANNELS};
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::model::vessel::state::{Actuators, VesselState};
 use crate::solve::Account;
 use nalgebra::{Matrix3, Vector3};
@@ -71,7 +71,13 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     let kp_rotational = gain("kp_rotational")?;
     let kd_rotational = gain("kd_rotational")?;
     let ki_rotational = gain("ki_rotational")?;
-    let euler_reference = p.vec3("control", "euler_reference", None, "rad", Range::Finite)?;
+    let euler_reference = p.vec3(
+        "control",
+        "euler_reference",
+        None,
+        "rad",
+        Range::Physical(&physical::ANGLE_RAD),
+    )?;
     let position_reference = p.vec3("control", "position_reference", None, "m", Range::Finite)?;
     let setpoint = setpoint(p, &euler_reference)?;
     let thrusters = thrusters::read(p)?;
@@ -114,7 +120,13 @@ fn setpoint(p: &mut Params, euler_reference: &[f64; 3]) -> crate::Result<Option<
             "setpoint.positions must have at least one row (m, spatial)".into(),
         ));
     }
-    let headings = p.rows(T, "headings", 1, "rad", Range::Finite)?;
+    let headings = p.rows(
+        T,
+        "headings",
+        1,
+        "rad",
+        Range::Physical(&physical::ANGLE_RAD),
+    )?;
     if let Some(hd) = &headings {
         if hd.len() != positions.len() {
             return Err(Error::InvalidInput(format!(
@@ -124,9 +136,9 @@ fn setpoint(p: &mut Params, euler_reference: &[f64; 3]) -> crate::Result<Option<
             )));
         }
     }
-    let times = p.rows(T, "times", 1, "s", Range::Finite)?;
+    let times = p.rows(T, "times", 1, "s", Range::Physical(&physical::TIME))?;
     let speed = p.opt_f64(T, "speed", "m/s", Range::Positive)?;
-    let start = p.opt_f64(T, "start_time", "s", Range::Finite)?;
+    let start = p.opt_f64(T, "start_time", "s", Range::Physical(&physical::TIME))?;
     let times: Vec<f64> = match (times, speed) {
         (Some(t), None) => {
             if start.is_some() {

@@ -2,18 +2,18 @@
 //! hang-off point on the hull (the paper's Fig. 1; docs/model.md §5.6).
 //!
 //! Table `[pipe]` (optional):
-//! - `submerged_weight` `w` (N/m, > 0) and `water_depth` (m, > 0, the seabed below the still
+//! - `submerged_weight` `w` (N/m, > 0) and `water_depth` (m, in (0, 11000], `physical::WATER_DEPTH`; the seabed below the still
 //!   water line, `z = 0` of the position);
 //! - `hang_off` (m, body frame, from the body origin): where the pipe leaves the vessel (the
 //!   stinger tip in S-lay, the tower's lower end in J-lay);
 //! - exactly one way to fix the catenary:
 //!   - `horizontal_tension` `H` (N) or `top_tension` `T` (N), held by the tensioner;
-//!   - `departure_angle` (degrees from the horizontal, in (0, 90)): the pipe's angle at the
+//!   - `departure_angle` (degrees from the horizontal, in [5, 90), `physical::DEPARTURE_ANGLE`): the pipe's angle at the
 //!     hang-off point (S-lay: the stinger's departure angle, typically 30–60°; J-lay: the
 //!     tower's angle, typically 80–90°);
 //!   - `touchdown = [x, y]` (m, spatial): a touchdown point on the seabed; the catenary then
 //!     follows from the horizontal span between it and the hang-off point;
-//! - `lay_direction` (degrees, spatial, from the x axis towards y): the direction in which the
+//! - `lay_direction` (degrees, spatial, from the x axis towards y, within ±360): the direction in which the
 //!   vessel lays the pipe; the pipe lies behind it. Required with a tension or an angle;
 //! - `lay_speed` (m/s, ≥ 0, default 0): with `touchdown`, the touchdown point moves along
 //!   `lay_direction` at this speed from t = 0 (the lay progressing).
@@ -34,7 +34,7 @@ use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::catenary::Catenary;
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::model::vessel::state::VesselState;
 use crate::solve::Account;
 use nalgebra::{Matrix3, Vector2, Vector3};
@@ -81,7 +81,12 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         return Ok(None);
     }
     let weight = p.f64(T, "submerged_weight", "N/m", Range::Positive)?;
-    let water_depth = p.f64(T, "water_depth", "m", Range::Positive)?;
+    let water_depth = p.f64(
+        T,
+        "water_depth",
+        "m",
+        Range::Physical(&physical::WATER_DEPTH),
+    )?;
     let hang_off: Vector3<f64> = p
         .vec3(T, "hang_off", None, "m, body frame", Range::Finite)?
         .into();
@@ -140,6 +145,14 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
                 "pipe.departure_angle must lie strictly between 0 and 90 (degrees from the horizontal), got {a}"
             )));
         }
+        let r = physical::DEPARTURE_ANGLE;
+        if !r.contains(a) {
+            return Err(Error::InvalidInput(format!(
+                "pipe.departure_angle must lie within {} (degrees from the horizontal; {}), got {a}",
+                r.interval(),
+                r.why
+            )));
+        }
         Mode::DepartureAngle(a.to_radians())
     } else {
         let td = td.expect("one was given");
@@ -152,7 +165,12 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         Mode::Touchdown(Vector2::new(td[0][0], td[1][0]))
     };
     let needs_direction = !matches!(mode, Mode::Touchdown(_));
-    let dir = p.opt_f64(T, "lay_direction", "degrees", Range::Finite)?;
+    let dir = p.opt_f64(
+        T,
+        "lay_direction",
+        "degrees",
+        Range::Physical(&physical::ANGLE_DEG),
+    )?;
     let lay_speed = p
         .opt_f64(T, "lay_speed", "m/s", Range::NonNegative)?
         .unwrap_or(0.0);

@@ -1,7 +1,7 @@
 //! Thrusters and thrust allocation: the actuators of the DP controller (docs/model.md §5.8).
 //!
 //! Table `[thrusters]` (optional; read with the controller, whose force they deliver):
-//! - `hull_length`, `hull_beam` (m, > 0): the hull's box, `|x| ≤ L/2`, `|y| ≤ B/2`, `|z| ≤ B/2`
+//! - `hull_length`, `hull_beam` (m, in (0, 500] and (0, 150], `physical::HULL_LENGTH`, `HULL_BEAM`): the hull's box, `|x| ≤ L/2`, `|y| ≤ B/2`, `|z| ≤ B/2`
 //!   about the body origin, inside which every thruster must sit;
 //! - `unit`: a list of thrusters (`[[thrusters.unit]]` tables), each with
 //!   - `kind`: `"tunnel"` (a fixed transverse axis, thrust of either sign), `"azimuth"` (turns
@@ -39,7 +39,7 @@
 //! lost while an azimuth turns.
 
 use crate::error::{Error, Result};
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::model::vessel::state::MAX_ACTUATORS;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
@@ -128,8 +128,13 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
     if !p.has(T) {
         return Ok(None);
     }
-    let length = p.f64(T, "hull_length", "m", Range::Positive)?;
-    let beam = p.f64(T, "hull_beam", "m", Range::Positive)?;
+    let length = p.f64(
+        T,
+        "hull_length",
+        "m",
+        Range::Physical(&physical::HULL_LENGTH),
+    )?;
+    let beam = p.f64(T, "hull_beam", "m", Range::Physical(&physical::HULL_BEAM))?;
     let raw = p.take_raw(T, "unit")?.ok_or_else(|| {
         Error::Parse("missing field `unit` in [thrusters]: a list of [[thrusters.unit]] tables (kind, position, max_thrust, ...)".into())
     })?;
@@ -179,7 +184,7 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
 }
 
 fn read_unit(p: &mut Params, s: &str, length: f64, beam: f64) -> Result<Thruster> {
-    let kind = match p.choice(s, "kind", &["tunnel", "azimuth", "fixed"])? {
+    let kind = match p.required_choice(s, "kind", &["tunnel", "azimuth", "fixed"])? {
         "tunnel" => Kind::Tunnel,
         "azimuth" => Kind::Azimuth,
         _ => Kind::Fixed,
@@ -215,7 +220,7 @@ fn read_unit(p: &mut Params, s: &str, length: f64, beam: f64) -> Result<Thruster
         Kind::Azimuth => (0.0, 0.0),
         Kind::Tunnel | Kind::Fixed => {
             let deg = p
-                .opt_f64(s, "angle", "degrees", Range::Finite)?
+                .opt_f64(s, "angle", "degrees", Range::Physical(&physical::ANGLE_DEG))?
                 .unwrap_or(if kind == Kind::Tunnel { 90.0 } else { 0.0 });
             let min = p.opt_f64(s, "min_thrust", "N", Range::Finite)?;
             let min = match (kind, min) {
