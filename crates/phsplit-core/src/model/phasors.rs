@@ -233,12 +233,12 @@ fn taylor(x: f64) -> (f64, f64) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A deterministic sequence in [0, 1) (a linear congruential generator, Knuth's MMIX
-    /// constants).
-    fn uniform(state: &mut u64) -> f64 {
+    /// constants); also the sea's tests' (`forces/waves.rs`).
+    pub(crate) fn uniform(state: &mut u64) -> f64 {
         *state = state
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);

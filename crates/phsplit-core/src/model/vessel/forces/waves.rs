@@ -630,14 +630,8 @@ fn dot2(a: &[f64], b: &[f64], c: &[f64], d: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::phasors::tests::uniform;
     use std::f64::consts::PI;
-
-    fn uniform(state: &mut u64) -> f64 {
-        *state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*state >> 11) as f64 / (1u64 << 53) as f64
-    }
 
     /// A sea of `n` components (`spread`: each its own direction; else all towards 211°) on
     /// tables of 16 directions and 12 frequencies with values of both signs.
