@@ -168,8 +168,13 @@ CATALOGUE: list[Bad] = [
         ("forse", "did you mean 'force'")),
     Bad("current faster than 10 m/s", vessel_with("[initial]", "[current]\nvelocity = [15.0, 0.0, 0.0]\n[initial]"),
         E, ("current.velocity[0]", "10 m/s")),
-    Bad("current given as a speed", vessel_with("[initial]", "[current]\nspeed = 1.0\n[initial]"), P,
-        ("speed", "[current]", "velocity")),
+    Bad("current given as a speed without a direction", vessel_with("[initial]", "[current]\nspeed = 1.0\n[initial]"), E,
+        ("current.speed", "current.direction", "direction_from")),
+    Bad("current given by a speed and its velocity", vessel_with("[initial]", "[current]\nspeed = 1.0\ndirection = 90.0\n"
+                                                                 "velocity = [0.5, 0.0, 0.0]\n[initial]"), E,
+        ("[current]", "velocity", "speed with a direction", "not both")),
+    Bad("current direction without a speed", vessel_with("[initial]", "[current]\ndirection_from = 20.0\n[initial]"), E,
+        ("current.direction_from", "current.speed", "current.velocity")),
     Bad("pipe with a negative submerged weight",
         vessel_with("[initial]", "[pipe]\nsubmerged_weight = -800.0\nwater_depth = 300.0\nhang_off = [-60.0, 0.0, 3.0]\n"
                     "horizontal_tension = 5e5\nlay_direction = 0.0\n[initial]"), E,
