@@ -19,10 +19,11 @@ use crate::flows::collocation::Z3;
 use crate::flows::rigid_body::MagnusOrder;
 use crate::lie::so3;
 use crate::methods::Flow;
-use crate::solve::{Account, AccountKind, FieldModel, Model, SplitModel, Work};
+use crate::solve::{Account, FieldModel, Model, SplitModel, Work};
 use nalgebra::{Matrix3, SVector, Vector3};
 
 mod memo;
+mod power;
 mod report;
 mod s1;
 mod s2;
@@ -346,31 +347,6 @@ impl<'a> VesselSystem<'a> {
         [b[0][0].diagonal(), b[1][1].diagonal()]
     }
 
-    fn sign(&self, k: usize) -> f64 {
-        match self.accounts[k].kind {
-            AccountKind::Supplied => 1.0,
-            AccountKind::Dissipated => -1.0,
-        }
-    }
-
-    /// Power per account at block states `z`, from the booked rows: `±(M⁻¹u)·f`.
-    fn power_at(&self, b: &S2Builder, z: &[Z3; 2]) -> Work {
-        let booked = b.booked.as_deref().expect("assembled with the ledger");
-        let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
-        let mut w = Work::from_fn(self.accounts.len(), |k| {
-            let mut p = 0.0;
-            for sys in 0..2 {
-                p += nu[sys].dot(&booked[k][sys].at(&nu, &z[sys]));
-            }
-            self.sign(k) * p
-        });
-        for (a, sys, r) in &b.cross_booked {
-            let k = *sys as usize;
-            w.add(*a, self.sign(*a) * nu[k].dot(&(r * z[1 - k][1])));
-        }
-        w
-    }
-
     /// The vector field of flow S1 (eq. 40) or S2 (eq. 41) at `s` and time `t`. Their sum is
     /// eq. (39).
     pub fn split_field(&self, s: &VesselState, t: f64, on: bool, which: Flow) -> VesselState {
@@ -431,32 +407,6 @@ impl<'a> VesselSystem<'a> {
         d.m += dm;
         d.q = s.q * so3::hat(&w);
         d
-    }
-
-    /// The power per account at `s` and time `t` (W).
-    pub fn power(&self, s: &VesselState, t: f64, on: bool) -> Work {
-        let fr = self.frozen(s, on);
-        let b = self.s2_of(&fr, true);
-        let z = self.blocks_of(s);
-        let mut w = self.power_at(&b, &z);
-        if self.forced {
-            let g = self.forcing(&fr, t, &z);
-            w += self.forcing_power(&[&g], &z);
-        }
-        w
-    }
-
-    /// The power per account of the sum of the forcings `gs` at block states `z`: `±(M⁻¹u)·f`.
-    fn forcing_power(&self, gs: &[&Forcing], z: &[Z3; 2]) -> Work {
-        let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
-        Work::from_fn(self.accounts.len(), |k| {
-            let mut p = 0.0;
-            for g in gs {
-                let f = g.booked(k);
-                p += nu[0].dot(&f[0]) + nu[1].dot(&f[1]);
-            }
-            self.sign(k) * p
-        })
     }
 }
 
@@ -634,6 +584,7 @@ impl FieldModel<{ super::STATE_DIM }> for VesselSystem<'_> {
 mod tests {
     use super::super::forces::external::{External, Frame};
     use super::*;
+    use crate::solve::AccountKind;
     use proptest::prelude::*;
 
     /// A 3-vector of the vessel's normalised parameters.
