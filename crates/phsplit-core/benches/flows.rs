@@ -10,6 +10,19 @@ use phsplit_core::model::vessel::{LinearFlow, Vessel, VesselSystem};
 use phsplit_core::solve::{run, Options};
 use std::hint::black_box;
 
+/// 1,000 steps of h = 0.05 s (where every method is stable), saving only the last state.
+fn thousand_steps(ledger: bool) -> Options {
+    Options {
+        t0: 0.0,
+        h: 0.05,
+        n_steps: 1000,
+        last_h: 0.05,
+        save_every: 1000,
+        outer: Outer::Dissipative,
+        ledger,
+    }
+}
+
 fn flows(c: &mut Criterion) {
     let vessel = Vessel::paper();
     let mut y0 = vessel.initial_state();
@@ -74,15 +87,7 @@ fn flows(c: &mut Criterion) {
         };
         for &lf in variants {
             let sys = VesselSystem::new(&vessel, Some(0.0)).with_linear_flow(lf);
-            let opts = Options {
-                t0: 0.0,
-                h: 0.05,
-                n_steps: 1000,
-                last_h: 0.05,
-                save_every: 1000,
-                outer: Outer::Dissipative,
-                ledger: false,
-            };
+            let opts = thousand_steps(false);
             let label = match (&method, lf) {
                 (Method::RungeKutta(_), _) => format!("1000 steps: {name}"),
                 (_, LinearFlow::Exact) => format!("1000 steps: {name} (exact S2)"),
@@ -118,15 +123,7 @@ fn vessel_steps(c: &mut Criterion) {
         y0.m += Vector3::new(1e5, -1e5, 3e5);
         for lf in [LinearFlow::Exact, LinearFlow::Gauss] {
             let sys = VesselSystem::new(&vessel, Some(0.0)).with_linear_flow(lf);
-            let opts = Options {
-                t0: 0.0,
-                h: 0.05,
-                n_steps: 1000,
-                last_h: 0.05,
-                save_every: 1000,
-                outer: Outer::Dissipative,
-                ledger: true,
-            };
+            let opts = thousand_steps(true);
             let label = format!("{name}: 1000 steps: sp2 ({lf:?} S2) + ledger");
             c.bench_function(&label, |b| {
                 b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
