@@ -95,6 +95,21 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "anchor": ("m", REQ, "the anchor, spatial frame, z up"),
         "stiffness": ("N/m", REQ, "the spring's stiffness `k`, > 0"),
     },
+    "port_hamiltonian": {
+        "name": ("-", '"port_hamiltonian"', "names its account and outputs: letters, digits, `_`, starting with a letter (§5.17)"),
+        "states": ("-", REQ, "the names of its `n` states, distinct, 1 to 64"),
+        "units": ("-", '"1" each', "a CF unit per state"),
+        "J": ("-", REQ, "`n×n`, skew-symmetric: the conservative interconnection"),
+        "R": ("-", REQ, "`n×n`, symmetric positive semidefinite: the dissipation"),
+        "Q": ("-", REQ, "`n×n`, symmetric positive definite: the storage `½ xᵀQx`"),
+        "G": ("-", REQ, "`n×k`: the input map"),
+        "P": ("-", "zero", "`n×k`: the input's dissipative part, `[[R, P], [Pᵀ, S]] ⪰ 0`"),
+        "S": ("-", "zero", "`k×k`, symmetric: the feedthrough's dissipative part"),
+        "N": ("-", "zero", "`k×k`, skew-symmetric: the feedthrough's conservative part"),
+        "input": ("-", REQ, "the `k` degrees of freedom of the body velocity it takes: `surge`, `sway`, `heave`, `roll`, `pitch`, `yaw`"),
+        "point": ("m", "[0, 0, 0]", "body frame: the translational inputs are this point's velocity, and the force acts there"),
+        "initial": ("the states' units", "zeros", "the states where a run starts"),
+    },
     "setpoint": {
         "natural_frequency": ("rad/s", REQ, "ω of Fossen's third-order reference model, > 0 (§5.7)"),
         "relative_damping": ("-", "1", "ζ, > 0 (1: critically damped)"),
@@ -205,6 +220,7 @@ SOURCE = {
     "crossflow_drag": "`forces/crossflow.rs`",
     "pipe": "`forces/pipe.rs`",
     "spring": "`forces/spring.rs`",
+    "port_hamiltonian": "`forces/port_hamiltonian.rs`",
     "setpoint": "`forces/pid.rs`",
     "thrusters": "`forces/thrusters.rs`",
     "thrusters.unit": "`forces/thrusters.rs`",
@@ -240,7 +256,8 @@ def accepted() -> dict[str, set[str]]:
                 scenario.load("dp-weather").vessel.to_dict(),
                 phsplit.Vessel.preset("osv").to_dict(),
                 {**paper, "external": {"force": [1.0, 0.0, 0.0]},
-                 "damping_quadratic": {"coefficients": [0.0] * 6}}]
+                 "damping_quadratic": {"coefficients": [0.0] * 6}},
+                _examples()["spring"], _examples()["port_hamiltonian"]]
     out: dict[str, set[str]] = {}
     for table in _core.vessel_tables():
         src = next(d for d in examples if table in d)
@@ -273,7 +290,11 @@ def _examples() -> dict[str, dict]:
             "current": weather, "pipe": pipelay, "setpoint": pipelay, "thrusters": pipelay, "waves": weather,
             "wind": weather, "crossflow_drag": phsplit.Vessel.preset("osv").to_dict(),
             "damping_quadratic": {**paper, "damping_quadratic": {"coefficients": [1.0] * 6}},
-            "spring": {**paper, "spring": {"fairlead": [30.0, 0.0, 0.0], "anchor": [700.0, 0.0, -5.0], "stiffness": 1.0e4}}}
+            "spring": {**paper, "spring": {"fairlead": [30.0, 0.0, 0.0], "anchor": [700.0, 0.0, -5.0], "stiffness": 1.0e4}},
+            "port_hamiltonian": {**paper, "port_hamiltonian": {
+                "name": "port_hamiltonian", "states": ["q", "p"], "units": ["1", "1"], "J": [[0.0, 1.0], [-1.0, 0.0]],
+                "R": [[0.0, 0.0], [0.0, 1.0]], "Q": [[1.0, 0.0], [0.0, 1.0]], "G": [[1.0], [0.0]], "P": [[0.0], [0.0]],
+                "S": [[0.0]], "N": [[0.0]], "input": ["roll"], "point": [0.0, 0.0, 0.0], "initial": [0.0, 0.0]}}}
 
 
 def _literal(text: str):

@@ -123,6 +123,15 @@ impl PyVessel {
     fn components(&self) -> Vec<&'static str> {
         self.inner.forces.iter().map(|f| f.name()).collect()
     }
+    /// The states the components keep of their own, in the state's layout after the body's 27
+    /// numbers: (name, unit, long name, initial value) each.
+    fn own_states(&self) -> Vec<(String, String, String, f64)> {
+        self.inner
+            .own_states()
+            .into_iter()
+            .map(|o| (o.name, o.unit, o.long_name, o.initial))
+            .collect()
+    }
     /// The ledger's accounts: (name, "supplied" or "dissipated") per account.
     fn accounts(&self) -> Vec<(&'static str, &'static str)> {
         use phsplit_core::solve::Model;

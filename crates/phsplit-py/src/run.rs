@@ -211,17 +211,17 @@ fn integrate<'py>(
     }
     d.set_item("outputs", reported)?;
     d.set_item("steps", traj.steps)?;
-    // A state that continues the run: the 27 numbers, then the memory of rate-limited
-    // thrusters (none for other vessels).
-    let continuing = |s: &VesselState| {
-        let mut v = s.to_vector().as_slice().to_vec();
-        v.extend(s.act.to_flat());
-        v
-    };
+    // A state that continues the run: the 27 numbers, the components' own states, then the
+    // memory of rate-limited thrusters (none for other vessels).
     d.set_item(
         "last_good",
-        PyArray1::from_vec(py, continuing(&traj.last_good)),
+        PyArray1::from_vec(py, traj.last_good.to_continuing()),
     )?;
+    let own = traj.states.first().map_or(0, |s| s.own.len());
+    if own > 0 {
+        let vals: Vec<f64> = traj.states.iter().flat_map(|s| s.own.clone()).collect();
+        d.set_item("own", PyArray1::from_vec(py, vals).reshape([n, own])?)?;
+    }
     let width = traj.states.first().map_or(0, |s| s.act.to_flat().len());
     let memory: Vec<f64> = traj.states.iter().flat_map(|s| s.act.to_flat()).collect();
     if width > 0 && memory.len() == n * width {

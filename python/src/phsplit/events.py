@@ -385,6 +385,7 @@ def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
                   "save_every": settings.save_every},
         outputs={k: (u, ln, np.array([s.outputs[k][2][i] for s, i, _ in src])) for k, (u, ln, _) in tmpl.outputs.items()},
         actuators=None if tmpl.actuators is None else np.array([s.actuators[i] for s, i, _ in src]),
+        own=None if tmpl.own is None else np.array([s.own[i] for s, i, _ in src]),
     )
     sol.meta["events"] = hits
     sol.meta.pop("provenance", None)  # several core calls: not rerunnable as one

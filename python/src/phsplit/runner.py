@@ -122,6 +122,7 @@ def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, ort
         settings=dict(used),
         outputs={k: (u, ln, np.asarray(v)) for k, (u, ln, v) in raw.get("outputs", {}).items()},
         actuators=raw.get("actuators"),
+        own=raw.get("own"),
     )
     # What reruns it (phsplit rerun): the vessel file, the initial state the core used, one chunk.
     sol.meta["running_max"] = dict(raw["running_max"])

@@ -104,6 +104,10 @@ class Solution:
     #: The memory of rate-limited thrusters at the saved states (time, each thruster's thrust,
     #: each thruster's angle in rad; docs/model.md §5.8), or None for a vessel without them.
     actuators: np.ndarray | None = None
+    #: The components' own states at the saved states (a port-Hamiltonian subsystem's, in the
+    #: vessel's layout: :meth:`Vessel.own_states`), or None for a vessel whose components keep
+    #: none. Each is also in :attr:`outputs` under its name.
+    own: np.ndarray | None = None
 
     def force(self, *accounts: str) -> np.ndarray:
         """Body-frame force (N, 3) of the named ledger accounts, summed (all when none given)."""
@@ -170,11 +174,13 @@ class Solution:
 
     def state(self, i: int = -1) -> np.ndarray:
         """The flat 27-vector state at saved index ``i`` (p, m, Q column-major, mu, x, phi_th,
-        phi_x), as the core takes it; for a vessel with rate-limited thrusters followed by
-        their memory (:attr:`actuators`), so that a run continued from it goes on as one run."""
+        phi_x), as the core takes it, followed by the components' own states (:attr:`own`) and,
+        for a vessel with rate-limited thrusters, their memory (:attr:`actuators`), so that a run
+        continued from it goes on as one run."""
         y = np.concatenate([self.p[i], self.m[i], self.Q[i].reshape(-1, order="F"), self.mu[i], self.x[i],
                             self.phi_th[i], self.phi_x[i]])
-        return y if self.actuators is None else np.concatenate([y, self.actuators[i]])
+        tail = [a[i] for a in (self.own, self.actuators) if a is not None]
+        return np.concatenate([y, *tail]) if tail else y
 
     def settings_toml(self) -> str:
         """The run's settings as a ``[simulation]`` TOML table (what a scenario file takes)."""

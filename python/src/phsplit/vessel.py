@@ -110,6 +110,13 @@ class Vessel:
         return list(self._once("components", self._inner.components))
 
     @property
+    def own_states(self) -> list[tuple[str, str, str, float]]:
+        """The states the components keep of their own (a port-Hamiltonian subsystem's), in the
+        order they follow the body's 27 numbers in a state: ``(name, unit, long_name, initial)``.
+        Empty for a vessel whose components keep none."""
+        return list(self._once("own_states", self._inner.own_states))
+
+    @property
     def mass_matrix(self) -> np.ndarray:
         """The 6x6 mass matrix ``M = M_RB + M_A`` (body frame, z up; kg, kg m, kg m^2 blocks):
         the momenta are ``(p, m) = M nu`` (docs/model.md §5.14)."""

@@ -435,3 +435,165 @@ impl Force for PortHamiltonian {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::model::vessel::{LinearFlow, Vessel, VesselSystem, PAPER_VESSEL_TOML};
+    use crate::solve::{AccountKind, Model};
+    use nalgebra::{DVector, Vector3};
+
+    /// A two-state subsystem on sway at a point off the centre and on roll, with every matrix
+    /// nonzero (`[[R, P], [Pᵀ, S]] ⪰ 0` by construction: `LLᵀ`).
+    const TABLE: &str = r#"
+[port_hamiltonian]
+name = "tank"
+states = ["a", "b"]
+units = ["rad", "kg m2 s-1"]
+J = [[0.0, 1.0], [-1.0, 0.0]]
+R = [[0.5, 0.1], [0.1, 0.4]]
+Q = [[3.0e6, 1.0], [1.0, 2.0e-6]]
+G = [[0.3, 1.0e-3], [2.0e5, -1.0e5]]
+P = [[0.2, 0.1], [0.1, -0.3]]
+S = [[0.35, -0.05], [-0.05, 0.4]]
+N = [[0.0, 0.7], [-0.7, 0.0]]
+input = ["sway", "roll"]
+point = [10.0, -2.0, 4.0]
+initial = [0.02, 1.0e4]
+"#;
+
+    fn vessel(extra: &str) -> crate::Result<Vessel> {
+        Vessel::from_toml_str(&format!("{PAPER_VESSEL_TOML}\n{extra}"))
+    }
+
+    #[test]
+    fn the_storage_pays_for_the_force_on_the_hull_and_the_dissipation() {
+        let v = vessel(TABLE).unwrap();
+        assert_eq!(v.own_dim(), 2);
+        let f = v.force("port_hamiltonian").unwrap();
+        let lin = f.own_linear().unwrap();
+        let q = DVector::from_column_slice(&[0.0; 2]);
+        let _ = q;
+        for seed in 0..20 {
+            let r = |k: u64| ((seed * 7919 + k * 104729) % 1000) as f64 / 500.0 - 1.0;
+            let x = DVector::from_vec(vec![0.05 * r(1), 3e4 * r(2)]);
+            let nu = DVector::from_vec(vec![
+                r(3),
+                r(4),
+                r(5),
+                0.01 * r(6),
+                0.02 * r(7),
+                0.01 * r(8),
+            ]);
+            let xdot = &lin.axx * &x + &lin.axnu * &nu;
+            let tau = &lin.fx * &x + &lin.fnu * &nu;
+            let mut xn = x.as_slice().to_vec();
+            xn.extend_from_slice(nu.as_slice());
+            let xn = DVector::from_vec(xn);
+            let d = xn.dot(&(&lin.diss * &xn));
+            // d/dt ½xᵀQx by a centred difference of the storage along x'.
+            let e = 1e-6;
+            let (xp, xm) = (&x + &xdot * e, &x - &xdot * e);
+            let rate = (f.own_storage(xp.as_slice()) - f.own_storage(xm.as_slice())) / (2.0 * e);
+            let want = -nu.dot(&tau) - d;
+            let scale = rate.abs().max(d.abs()).max(nu.dot(&tau).abs());
+            assert!((rate - want).abs() <= 1e-7 * scale, "{rate} vs {want}");
+            assert!(d >= -1e-12 * scale, "dissipation {d}");
+        }
+    }
+
+    #[test]
+    fn the_ledger_closes_on_one_sub_step_of_either_flow_s2() {
+        let v = vessel(TABLE).unwrap();
+        let mut s0 = v.initial_state();
+        s0.p += Vector3::new(1e6, -2e6, 3e5);
+        s0.m += Vector3::new(4e6, 1e6, -2e6);
+        for lf in [LinearFlow::Exact, LinearFlow::Gauss] {
+            let sys = VesselSystem::new(&v, Some(0.0)).with_linear_flow(lf);
+            for stages in 1..=3 {
+                let mut s = s0.clone();
+                let w = sys.flow_s2(&mut s, 0.9, 0.0, true, true, stages);
+                let acc = sys.accounts();
+                let booked =
+                    w.total(acc, AccountKind::Supplied) - w.total(acc, AccountKind::Dissipated);
+                let dh = v.energy(&s) - v.energy(&s0);
+                let k = acc.iter().position(|a| a.name == "tank").unwrap();
+                assert!(
+                    w.get(k) > 0.0,
+                    "{lf:?} s={stages}: the tank dissipates {}",
+                    w.get(k)
+                );
+                let flows: f64 = (0..acc.len()).map(|i| w.get(i).abs()).sum();
+                let size = v.energy(&s0).max(v.energy(&s)).max(flows);
+                eprintln!("{lf:?} s={stages}: {:.3e}", (dh - booked).abs() / size);
+                assert!(
+                    (dh - booked).abs() <= 1e-10 * size,
+                    "{lf:?} s={stages}: ΔH {dh} booked {booked}"
+                );
+                assert!(s.own.iter().zip(&s0.own).any(|(a, b)| a != b));
+            }
+        }
+    }
+
+    #[test]
+    fn bad_matrices_are_named() {
+        let cases = [
+            (
+                "J = [[0.0, 1.0], [-1.0, 0.0]]",
+                "J = [[0.0, 1.0], [1.0, 0.0]]",
+                "port_hamiltonian.J must be skew",
+            ),
+            (
+                "R = [[0.5, 0.1], [0.1, 0.4]]",
+                "R = [[0.5, 0.1], [0.2, 0.4]]",
+                "port_hamiltonian.R must be symmetric",
+            ),
+            (
+                "R = [[0.5, 0.1], [0.1, 0.4]]",
+                "R = [[-0.5, 0.1], [0.1, 0.4]]",
+                "port_hamiltonian.R must be symmetric positive semidefinite",
+            ),
+            (
+                "Q = [[3.0e6, 1.0], [1.0, 2.0e-6]]",
+                "Q = [[3.0e6, 1.0], [1.0, -2.0e-6]]",
+                "port_hamiltonian.Q must be symmetric positive definite",
+            ),
+            (
+                "G = [[0.3, 1.0e-3], [2.0e5, -1.0e5]]",
+                "G = [[0.3], [2.0e5]]",
+                "port_hamiltonian.G must be 2×2",
+            ),
+            (
+                "S = [[0.35, -0.05], [-0.05, 0.4]]",
+                "S = [[0.0, 0.0], [0.0, 0.0]]",
+                "[[R, P], [Pᵀ, S]] must be positive semidefinite",
+            ),
+            (
+                "input = [\"sway\", \"roll\"]",
+                "input = [\"sway\", \"rol\"]",
+                "port_hamiltonian.input[1] must be one of",
+            ),
+            (
+                "input = [\"sway\", \"roll\"]",
+                "input = [\"roll\", \"roll\"]",
+                "names \"roll\" twice",
+            ),
+            (
+                "states = [\"a\", \"b\"]",
+                "states = [\"a\", \"a\"]",
+                "names \"a\" twice",
+            ),
+            (
+                "initial = [0.02, 1.0e4]",
+                "initial = [0.02]",
+                "port_hamiltonian.initial must give one value per state",
+            ),
+        ];
+        for (from, to, want) in cases {
+            assert!(TABLE.contains(from), "{from}");
+            let e = vessel(&TABLE.replace(from, to)).unwrap_err().to_string();
+            assert!(e.contains(want), "{to}: {e}");
+        }
+        let e = vessel(&TABLE.replace("J = [[0.0, 1.0], [-1.0, 0.0]]\n", "")).unwrap_err();
+        assert!(e.to_string().contains("port_hamiltonian.J"), "{e}");
+    }
+}

@@ -280,18 +280,34 @@ impl VesselSystem<'_> {
             let e = (&ab * h).exp();
             return ((e * wb).component_mul(&sc), Work::default());
         }
-        // exp([[−Ã, w̃w̃ᵀ], [0, Ãᵀ]] h) = [[·, F12], [0, F22]], F22 = e^{Ãᵀh},
-        // ∫₀ʰ e^{Ãs} w̃w̃ᵀ e^{Ãᵀs} ds = F22ᵀ F12.
+        // Van Loan on a piece τ = h/2^k short enough that e^{−Ãτ} stays bounded (a stiff
+        // subsystem would overflow it over the whole h): exp([[−Ã, w̃w̃ᵀ], [0, Ãᵀ]] τ) =
+        // [[·, F12], [0, F22]], F22 = e^{Ãᵀτ}, X(τ) = ∫₀^τ e^{Ãs} w̃w̃ᵀ e^{Ãᵀs} ds = F22ᵀ F12; then
+        // doubled, X(2τ) = X(τ) + e^{Ãτ} X(τ) e^{Ãᵀτ}, which only ever multiplies by the flow.
+        let norm = (0..n)
+            .map(|j| ab.column(j).iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0, f64::max)
+            * h.abs();
+        let k = if norm > 1.0 {
+            norm.log2().ceil() as i32
+        } else {
+            0
+        };
+        let tau = h / 2f64.powi(k);
         let mut big = DMatrix::zeros(2 * n, 2 * n);
-        big.view_mut((0, 0), (n, n)).copy_from(&(-&ab * h));
+        big.view_mut((0, 0), (n, n)).copy_from(&(-&ab * tau));
         big.view_mut((0, n), (n, n))
-            .copy_from(&(&wb * wb.transpose() * h));
+            .copy_from(&(&wb * wb.transpose() * tau));
         big.view_mut((n, n), (n, n))
-            .copy_from(&(ab.transpose() * h));
+            .copy_from(&(ab.transpose() * tau));
         let f = big.exp();
-        let f22t = f.view((n, n), (n, n)).transpose();
-        let gram = &f22t * f.view((0, n), (n, n));
-        let w1 = (&f22t * &wb).component_mul(&sc);
+        let mut e = f.view((n, n), (n, n)).transpose();
+        let mut gram = &e * f.view((0, n), (n, n));
+        for _ in 0..k {
+            gram = &gram + &e * &gram * e.transpose();
+            e = &e * &e;
+        }
+        let w1 = (&e * &wb).component_mul(&sc);
         let forms = self.power_forms(b);
         let work = Work::from_fn(self.accounts.len(), |acc| {
             let w = &forms[acc];
