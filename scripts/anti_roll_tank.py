@@ -162,7 +162,7 @@ def measure(path: str, t_skip: float = 300.0) -> dict:
     sway["port_hamiltonian"] = {**{n: v for n, v in data["port_hamiltonian"].items() if n not in ph},
                                 **ph, "input": ["sway", "roll"], "point": [0.0, 0.0, -k["r_d"]]}
     out = {}
-    for label, d in (("without", frozen), ("with", data), ("with, sway coupled", sway)):
+    for label, d in (("without the tank", frozen), ("with the tank", data), ("with the tank, sway-coupled", sway)):
         sc = scenario.from_dict(d, scenario.resolve(path))
         sol = phsplit.simulate(sc.vessel, settings=sc.settings)
         keep = sol.t >= t_skip
@@ -187,7 +187,9 @@ if __name__ == "__main__":
         print()
         print("| | roll RMS (deg) | max roll (deg) |")
         print("|---|---|---|")
-        for label in ("without", "with", "with, sway coupled"):
-            print(f"| {label} the tank | {r[label]['rms']:.3f} | {r[label]['max']:.3f} |")
-        print(f"RMS reduced by {100 * (1 - r['with']['rms'] / r['without']['rms']):.1f} %,"
-              f" max by {100 * (1 - r['with']['max'] / r['without']['max']):.1f} %")
+        for label in r:
+            print(f"| {label} | {r[label]['rms']:.3f} | {r[label]['max']:.3f} |")
+        base = r["without the tank"]
+        for label in list(r)[1:]:
+            print(f"{label}: RMS {100 * (r[label]['rms'] / base['rms'] - 1):+.1f} %,"
+                  f" max {100 * (r[label]['max'] / base['max'] - 1):+.1f} %")

@@ -140,3 +140,33 @@ def test_the_tank_reduces_the_roll_in_the_beam_sea():
     np.testing.assert_allclose(with_tank.outputs["tank_storage"][2], 0.5 * C * eta ** 2 + 0.5 * pi ** 2 / A, rtol=1e-10)
     y = (c / C - a / A) * C * eta - a * B / A * (pi / A) + a * a * B / A ** 2 * p
     np.testing.assert_allclose(with_tank.outputs["tank_force_roll"][2], -y, rtol=1e-9, atol=1e-9 * np.abs(y).max())
+
+
+def test_the_sway_coupled_form_keeps_the_energy_of_hull_and_fluid():
+    """The variant with the inputs (the duct's sway velocity, the roll rate) at the duct's point:
+    its matrices pass the checks, and its storage plus the hull with the mass correction b bᵀ/A
+    taken off is the whole kinetic energy, at random velocities."""
+    k = lloyd_coefficients()
+    A, B, C, c, q_t = k["A"], k["B"], k["C"], k["c"], k["q_t"]
+    r_d = KEEL_BELOW_CG - k["h_d"] / 2
+    a = np.array([q_t, q_t * H_R])                     # tau' (a . u): the duct's and the columns' share
+    Q = np.diag([C, 1 / A])
+    P = np.array([[0.0, 0.0], -B * a / A])
+    S = B * np.outer(a, a) / A ** 2
+    big = np.block([[np.diag([0.0, B]), P], [P.T, S]])
+    assert np.linalg.eigvalsh(big).min() >= -1e-12 * np.abs(big).max()
+    b = np.zeros(6)
+    b[1], b[3] = q_t, q_t * (r_d + H_R)
+    M = np.diag([PAPER["mass"]] * 3 + [PAPER["roll_inertia"], 2.726143e9, 2.9e9])
+    reduced = M - np.outer(b, b) / A
+    assert np.linalg.eigvalsh(reduced).min() > 0
+    rng = np.random.default_rng(3)
+    for nu, dtau in zip(rng.normal(scale=0.3, size=(20, 6)), rng.normal(scale=0.05, size=20)):
+        nu[3:] *= 0.1
+        u = np.array([nu[1] + r_d * nu[3], nu[3]])      # the duct's sway velocity (point [0, 0, -r_d]), the roll rate
+        pi = A * dtau + a @ u
+        whole = 0.5 * nu @ M @ nu + dtau * (a @ u) + 0.5 * A * dtau ** 2
+        assert math.isclose(0.5 * pi ** 2 / A + 0.5 * nu @ reduced @ nu, whole, rel_tol=1e-12)
+        # and the dissipation booked is the duct's loss, B tau'^2
+        z = np.concatenate([Q @ np.array([0.0, pi]), u])
+        assert math.isclose(z @ big @ z, B * dtau ** 2, rel_tol=1e-8, abs_tol=1e-9 * B * dtau ** 2 + 1e-9)
