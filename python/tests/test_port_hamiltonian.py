@@ -168,6 +168,28 @@ def test_reference_subsystem_loses_exactly_its_dissipation(case):
         np.testing.assert_allclose(e, Q @ xc)
 
 
+def test_reference_input_is_the_velocity_of_the_point_and_the_load_acts_there():
+    """The fender's u = (sway velocity of its point, v + w x r; roll rate), and its load on the
+    hull the force -y_sway e_y at the point with its moment r x f, plus the moment -y_roll e_x."""
+    d = params(FENDER, damping_translational=[0.0] * 3, damping_rotational=[0.0] * 3)
+    bare = params({**FENDER, "G": [[0.0, 0.0], [0.0, 0.0]], "P": [[0.0, 0.0], [0.0, 0.0]],
+                   "S": [[0.0, 0.0], [0.0, 0.0]], "N": [[0.0, 0.0], [0.0, 0.0]]},
+                  damping_translational=[0.0] * 3, damping_rotational=[0.0] * 3)
+    f, f0 = ref.Field(d, False), ref.Field(bare, False)
+    y = np.concatenate([kicked_start(), FENDER["initial"]])
+    v, w, r = y[0:3] / f.mv, y[3:6] / f.T, np.array(FENDER["point"])
+    _, _, u, yc = f.ph_port(y)
+    np.testing.assert_allclose(u, [(v + np.cross(w, r))[1], w[0]], rtol=1e-14)
+    force = np.array([0.0, -yc[0], 0.0])
+    dy, dy0 = f(0.0, y), f0(0.0, y)
+    np.testing.assert_allclose(dy[0:3] - dy0[0:3], force, rtol=1e-12, atol=1e-9 * abs(yc[0]))
+    np.testing.assert_allclose(dy[3:6] - dy0[3:6], np.cross(r, force) - [yc[1], 0.0, 0.0], rtol=1e-12,
+                               atol=1e-9 * np.abs(yc).max() * 31)
+    # with every coupling zero the hull is the reference without the table
+    np.testing.assert_array_equal(dy0[:27], ref.Field(phsplit.Vessel.paper().to_dict() | {"vessel": bare["vessel"]},
+                                                      False)(0.0, y[:27]))
+
+
 # -- phsplit against the reference ----------------------------------------------------------
 
 T_END = 2.0
