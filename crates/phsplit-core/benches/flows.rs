@@ -58,9 +58,9 @@ fn flows(c: &mut Criterion) {
         let sys = VesselSystem::new(&vessel, Some(0.0)).with_linear_flow(lf);
         // Two attitudes in turn: each call assembles flow S2 (a repeated state would be served
         // by the kept assembly, `system/memo.rs`, and measure the solve alone).
-        let mut y1 = y0;
+        let mut y1 = y0.clone();
         y1.q = nalgebra::Rotation3::from_euler_angles(0.02, -0.01, 0.3).into_inner();
-        let states = [y0, y1];
+        let states = [y0.clone(), y1];
         for ledger in [false, true] {
             let mut n = 0usize;
             c.bench_function(
@@ -68,7 +68,7 @@ fn flows(c: &mut Criterion) {
                 |b| {
                     b.iter(|| {
                         n += 1;
-                        let mut s = states[n & 1];
+                        let mut s = states[n & 1].clone();
                         sys.flow_s2(&mut s, black_box(0.5), 0.0, true, ledger, order.div_ceil(2))
                     })
                 },
@@ -94,7 +94,7 @@ fn flows(c: &mut Criterion) {
                 (_, LinearFlow::Gauss) => format!("1000 steps: {name} (gauss S2)"),
             };
             c.bench_function(&label, |b| {
-                b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
+                b.iter(|| run(&sys, &method, black_box(y0.clone()), &opts).unwrap())
             });
             // With the ledger (a step's cost with every account booked).
             if let Method::Splitting(_) = method {
@@ -103,7 +103,7 @@ fn flows(c: &mut Criterion) {
                     ..opts
                 };
                 c.bench_function(&format!("{label} + ledger"), |b| {
-                    b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
+                    b.iter(|| run(&sys, &method, black_box(y0.clone()), &opts).unwrap())
                 });
             }
         }
@@ -126,7 +126,7 @@ fn vessel_steps(c: &mut Criterion) {
             let opts = thousand_steps(true);
             let label = format!("{name}: 1000 steps: sp2 ({lf:?} S2) + ledger");
             c.bench_function(&label, |b| {
-                b.iter(|| run(&sys, &method, black_box(y0), &opts).unwrap())
+                b.iter(|| run(&sys, &method, black_box(y0.clone()), &opts).unwrap())
             });
         }
     }

@@ -40,7 +40,7 @@ fn main() {
     let t = std::time::Instant::now();
     let mut e = 0.0;
     for _ in 0..reps {
-        let tr = run(&sys, &method, black_box(y0), &opts).unwrap();
+        let tr = run(&sys, &method, black_box(y0.clone()), &opts).unwrap();
         e += tr.energy[tr.energy.len() - 1];
     }
     let dt = t.elapsed().as_secs_f64();

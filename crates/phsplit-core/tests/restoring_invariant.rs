@@ -27,7 +27,7 @@ fn final_state(method: &str, h: f64, t1: f64, project: bool) -> (VesselState, Ve
     let traj = run(&sys, &s.method, v.initial_state(), &opts).unwrap();
     assert_eq!(traj.status, Status::Completed, "{method} h={h}");
     let n = traj.states.len();
-    (traj.states[n - 2], traj.states[n - 1])
+    (traj.states[n - 2].clone(), traj.states[n - 1].clone())
 }
 
 fn invariant(v: &Vessel, s: &VesselState) -> Vector3<f64> {
@@ -174,7 +174,7 @@ fn the_projection_is_the_smallest_turn_and_leaves_round_off_alone() {
         let mut s = v.initial_state();
         s.q = q0.into_inner();
         s.mu = Vector3::new(g1 * t_true.x, g2 * t_true.y, 0.0);
-        let before = s;
+        let before = s.clone();
         sys.project(&mut s);
         let q3 = before.q.transpose() * Vector3::z();
         // The attitude's vertical the invariant asks for, from mu (independently of the code).

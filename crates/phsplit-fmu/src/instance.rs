@@ -407,12 +407,13 @@ impl Instance {
         let sys = VesselSystem::new(&r.vessel, r.settings.control_start)
             .with_linear_flow(r.settings.linear_flow)
             .with_projection(r.settings.project_invariants);
-        let traj = run(&sys, &r.settings.method, r.state, &opts).map_err(|e| e.to_string())?;
+        let traj =
+            run(&sys, &r.settings.method, r.state.clone(), &opts).map_err(|e| e.to_string())?;
         if let Status::Failed { t, reason, .. } = &traj.status {
             return Err(format!("the internal step from t = {t} s failed: {reason}; the step h is too long for this method, or the inputs are extreme"));
         }
         let last = traj.states.len() - 1;
-        r.state = traj.states[last];
+        r.state = traj.states[last].clone();
         // Booked per saved interval (the first is zero): here the whole communication step.
         for w in &traj.booked {
             for (k, acc) in r.booked.iter_mut().enumerate() {

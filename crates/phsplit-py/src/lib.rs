@@ -142,7 +142,9 @@ impl PyVessel {
         state: PyReadonlyArray1<'_, f64>,
         control: bool,
     ) -> PyResult<Vec<f64>> {
-        let s = VesselState::from_slice_user(&entries(&state), true, self.inner.actuators())
+        let s = self
+            .inner
+            .user_state(&entries(&state), true)
             .map_err(to_py)?;
         Ok(VesselSystem::new(&self.inner, None).natural_periods(&s.q, control))
     }
@@ -156,7 +158,9 @@ impl PyVessel {
         t: f64,
         control_start: Option<f64>,
     ) -> PyResult<std::collections::BTreeMap<String, f64>> {
-        let s = VesselState::from_slice_continuing(&entries(&state), self.inner.actuators())
+        let s = self
+            .inner
+            .continuing_state(&entries(&state))
             .map_err(to_py)?;
         let sys = VesselSystem::new(&self.inner, control_start);
         Ok(sys
@@ -168,7 +172,9 @@ impl PyVessel {
     /// The stored energy H of eq. (35) at a flat 27-vector state (J; a memory of rate-limited
     /// thrusters after it is allowed: it stores no energy).
     fn energy(&self, state: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
-        let s = VesselState::from_slice_user(&entries(&state), true, self.inner.actuators())
+        let s = self
+            .inner
+            .user_state(&entries(&state), true)
             .map_err(to_py)?;
         Ok(self.inner.energy(&s))
     }

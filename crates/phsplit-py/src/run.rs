@@ -67,14 +67,11 @@ fn integrate<'py>(
     let opts = settings.options().map_err(to_py)?;
     let y0 = match &state0 {
         None => vessel.inner.initial_state(),
-        Some(a) if continuing => {
-            VesselState::from_slice_continuing(&entries(a), vessel.inner.actuators())
-                .map_err(to_py)?
-        }
-        Some(a) => {
-            VesselState::from_slice_user(&entries(a), orthonormalize, vessel.inner.actuators())
-                .map_err(to_py)?
-        }
+        Some(a) if continuing => vessel.inner.continuing_state(&entries(a)).map_err(to_py)?,
+        Some(a) => vessel
+            .inner
+            .user_state(&entries(a), orthonormalize)
+            .map_err(to_py)?,
     };
     vessel
         .inner

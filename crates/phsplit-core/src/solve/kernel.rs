@@ -49,7 +49,7 @@ pub fn run_splitting_watched<M: SplitModel>(
     let last = subs.len() - 1;
     let mut y0 = y0;
     model.begin(opts.t0, &mut y0);
-    let mut rec = Recorder::new(model, opts.t0, y0, opts);
+    let mut rec = Recorder::new(model, opts.t0, y0.clone(), opts);
     let mut y = y0;
     // A last sub-step deferred into the next step: (flow, length, its step's start time, the
     // time it starts at).
@@ -101,13 +101,13 @@ pub fn run_splitting_watched<M: SplitModel>(
         rec.traj.steps = n + 1;
         if pending.is_none() {
             // y sits on the step boundary (no sub-step deferred into the next step).
-            rec.traj.last_good = y;
+            rec.traj.last_good.clone_from(&y);
             rec.traj.t_last_good = t1;
             rec.observe(t1, &y);
         }
         let saved = saves_after(n, opts);
         if saved {
-            rec.save(t1, y);
+            rec.save(t1, y.clone());
         }
         if n + 1 < opts.n_steps && !monitor.keep_going(n + 1) {
             // Complete the step (a deferred sub-step), then stop on its boundary.
@@ -155,8 +155,8 @@ pub fn run_runge_kutta_watched<const N: usize, M: FieldModel<N>>(
         return Err(crate::Error::InvalidInput(why));
     }
     let s = tableau.stages();
-    let mut rec = Recorder::new(model, opts.t0, y0, opts);
     let mut y = model.to_vector(&y0);
+    let mut rec = Recorder::new(model, opts.t0, y0, opts);
     let mut k: Vec<SVector<f64, N>> = vec![SVector::zeros(); s];
     for n in 0..opts.n_steps {
         let t = opts.t0 + n as f64 * opts.h;

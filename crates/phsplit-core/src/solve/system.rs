@@ -185,7 +185,7 @@ impl Work {
 
 /// What every kernel needs of a model.
 pub trait Model {
-    type State: Copy;
+    type State: Clone;
     /// Stored energy (the Hamiltonian).
     fn energy(&self, s: &Self::State) -> f64;
     /// Whether the state is usable (finite).

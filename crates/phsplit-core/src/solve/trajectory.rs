@@ -107,15 +107,15 @@ impl<'m, M: Model> Recorder<'m, M> {
             dissipated: Vec::with_capacity(capacity),
             steps: 0,
             status: Status::Completed,
-            last_good: y0,
+            last_good: y0.clone(),
             t_last_good: t0,
             probe_names: model.probe_names().to_vec(),
             probe_max: vec![f64::NEG_INFINITY; model.probe_names().len()],
             probe_max_t: vec![t0; model.probe_names().len()],
         };
         traj.t.push(t0);
-        traj.states.push(y0);
         traj.energy.push(model.energy(&y0));
+        traj.states.push(y0);
         traj.booked.push(Work::default());
         traj.supplied.push(0.0);
         traj.dissipated.push(0.0);
@@ -125,6 +125,7 @@ impl<'m, M: Model> Recorder<'m, M> {
             acc: Work::default(),
             probed: Vec::new(),
         };
+        let y0 = rec.traj.last_good.clone();
         rec.observe(t0, &y0);
         rec
     }
@@ -164,7 +165,7 @@ impl<'m, M: Model> Recorder<'m, M> {
         saved: bool,
     ) -> Trajectory<M::State> {
         if !saved {
-            self.save(t, y);
+            self.save(t, y.clone());
         }
         self.traj.steps = steps;
         self.traj.last_good = y;
@@ -175,8 +176,8 @@ impl<'m, M: Model> Recorder<'m, M> {
     pub(crate) fn save(&mut self, t: f64, y: M::State) {
         let acc = &self.traj.accounts;
         self.traj.t.push(t);
-        self.traj.states.push(y);
         self.traj.energy.push(self.model.energy(&y));
+        self.traj.states.push(y);
         self.traj
             .supplied
             .push(self.acc.total(acc, AccountKind::Supplied));

@@ -227,6 +227,11 @@ impl Vessel {
             phi_th: z,
             phi_x: z,
             act: Default::default(),
+            own: self
+                .forces
+                .iter()
+                .flat_map(|f| f.own_states().iter().map(|o| o.initial))
+                .collect(),
         };
         for f in &self.forces {
             f.init_state(&mut s);
@@ -262,8 +267,61 @@ impl Vessel {
             .try_for_each(|f| f.check_memory(&s.act, t0))
     }
 
-    /// The energy `H` of eq. (35), J (without constant terms).
+    /// The energy `H` of eq. (35), J (without constant terms), with the storage of the
+    /// components' own states.
     pub fn energy(&self, s: &VesselState) -> f64 {
-        self.body.kinetic_energy(s) + self.forces.iter().map(|f| f.storage(s)).sum::<f64>()
+        let own: f64 = self
+            .own_layout()
+            .map(|(f, r)| f.own_storage(&s.own[r]))
+            .sum();
+        self.body.kinetic_energy(s) + self.forces.iter().map(|f| f.storage(s)).sum::<f64>() + own
+    }
+
+    /// The components that keep states of their own, each with its range in
+    /// [`VesselState::own`] (in the order of the components).
+    pub fn own_layout(&self) -> impl Iterator<Item = (&Arc<dyn Force>, std::ops::Range<usize>)> {
+        let mut off = 0;
+        self.forces.iter().filter_map(move |f| {
+            let n = f.own_states().len();
+            (n > 0).then(|| {
+                off += n;
+                (f, off - n..off)
+            })
+        })
+    }
+
+    /// How many states the components keep of their own ([`VesselState::own`]).
+    pub fn own_dim(&self) -> usize {
+        self.forces.iter().map(|f| f.own_states().len()).sum()
+    }
+
+    /// Where the components' own states start, in the layout's order.
+    pub fn own_initial(&self) -> Vec<f64> {
+        self.own_states().iter().map(|o| o.initial).collect()
+    }
+
+    /// A state that continues a run ([`VesselState::from_slice_continuing`]); a state of the
+    /// body's 27 numbers alone takes the own states' initial values.
+    pub fn continuing_state(&self, y: &[f64]) -> Result<VesselState> {
+        let own = self.own_initial();
+        if y.len() == state::STATE_DIM && !own.is_empty() {
+            let mut v = y.to_vec();
+            v.extend_from_slice(&own);
+            return VesselState::from_slice_continuing(&v, own.len(), self.actuators());
+        }
+        VesselState::from_slice_continuing(y, own.len(), self.actuators())
+    }
+
+    /// A state a user gives ([`VesselState::from_slice_user`]).
+    pub fn user_state(&self, y: &[f64], orthonormalize: bool) -> Result<VesselState> {
+        VesselState::from_slice_user(y, orthonormalize, &self.own_initial(), self.actuators())
+    }
+
+    /// The components' own states, in the layout's order ([`Self::own_layout`]).
+    pub fn own_states(&self) -> Vec<forces::OwnState> {
+        self.forces
+            .iter()
+            .flat_map(|f| f.own_states().iter().cloned())
+            .collect()
     }
 }

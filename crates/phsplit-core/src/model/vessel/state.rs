@@ -5,7 +5,7 @@ use crate::lie::so3;
 use nalgebra::{Matrix3, SVector, Vector3};
 
 /// The state of the vessel (27 numbers with `Q` stored as a matrix).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct VesselState {
     /// Linear momentum `p = mv v`, body frame, kg m/s.
     pub p: Vector3<f64>,
@@ -24,6 +24,10 @@ pub struct VesselState {
     /// What rate-limited thrusters deliver (none for other vessels): not part of the 27-vector
     /// the flows integrate, but a memory the run keeps from step to step.
     pub act: Actuators,
+    /// The components' own states (a linear port-Hamiltonian subsystem's, …), in the order of
+    /// the vessel's layout of them (`Vessel::own_layout`); empty for a vessel whose components
+    /// keep none. Integrated with the rest in flow S2; flow S1 leaves them unchanged.
+    pub own: Vec<f64>,
 }
 
 /// Most thrusters a vessel with rate-limited thrusters may have (their memory is part of the
@@ -135,12 +139,14 @@ impl VesselState {
             phi_th: v3(5),
             phi_x: v3(6),
             act: Actuators::default(),
+            own: Vec::new(),
         }
     }
 
     /// Whether every component is finite.
     pub fn is_finite(&self) -> bool {
         self.parts().iter().all(|p| p.iter().all(|v| v.is_finite()))
+            && self.own.iter().all(|v| v.is_finite())
     }
 
     /// A state from a flat vector given by a user: the right length, finite, and with an
@@ -149,22 +155,20 @@ impl VesselState {
     /// its length and finiteness are checked. An explicit Runge–Kutta method lets `Q` drift off
     /// SO(3) by its own error, and the continuation must take the state as it is, so that a run
     /// cut into several calls gives the same numbers as one call.
-    /// A vessel with `actuators` rate-limited thrusters may follow the 27 numbers with their
-    /// memory ([`Actuators::to_flat`]); without it the run starts them afresh.
-    pub fn from_slice_continuing(y: &[f64], actuators: usize) -> Result<Self> {
-        let with_memory = STATE_DIM + 1 + 2 * actuators;
-        if y.len() != STATE_DIM && (actuators == 0 || y.len() != with_memory) {
-            return Err(Error::InvalidInput(if actuators == 0 {
-                format!(
-                    "a state is a flat vector of {STATE_DIM} numbers, got {}",
-                    y.len()
-                )
-            } else {
-                format!(
-                    "a state to continue from is a flat vector of {STATE_DIM} numbers, or {with_memory} with the memory of the {actuators} rate-limited thrusters, got {}",
-                    y.len()
-                )
-            }));
+    /// After the 27 numbers come the components' `own` states (all of them), then, for a vessel
+    /// with `actuators` rate-limited thrusters, optionally their memory
+    /// ([`Actuators::to_flat`]); without it the run starts them afresh.
+    pub fn from_slice_continuing(y: &[f64], own: usize, actuators: usize) -> Result<Self> {
+        let base = STATE_DIM + own;
+        let with_memory = base + 1 + 2 * actuators;
+        if y.len() != base && (actuators == 0 || y.len() != with_memory) {
+            let what = match (own, actuators) {
+                (0, 0) => format!("a state is a flat vector of {STATE_DIM} numbers"),
+                (0, a) => format!("a state to continue from is a flat vector of {STATE_DIM} numbers, or {with_memory} with the memory of the {a} rate-limited thrusters"),
+                (o, 0) => format!("a state to continue from is a flat vector of {base} numbers ({STATE_DIM}, then the components' {o} own states)"),
+                (o, a) => format!("a state to continue from is a flat vector of {base} numbers ({STATE_DIM}, then the components' {o} own states), or {with_memory} with the memory of the {a} rate-limited thrusters"),
+            };
+            return Err(Error::InvalidInput(format!("{what}, got {}", y.len())));
         }
         if let Some(i) = y.iter().position(|v| !v.is_finite()) {
             return Err(Error::InvalidInput(format!(
@@ -175,35 +179,73 @@ impl VesselState {
         let mut s = Self::from_vector(&SVector::<f64, STATE_DIM>::from_column_slice(
             &y[..STATE_DIM],
         ));
-        if y.len() > STATE_DIM {
-            s.act = Actuators::from_flat(&y[STATE_DIM..], actuators)?;
+        s.own = y[STATE_DIM..base].to_vec();
+        if y.len() > base {
+            s.act = Actuators::from_flat(&y[base..], actuators)?;
         }
         Ok(s)
     }
 
-    /// [`Self::from_slice_checked`] for a vessel with `actuators` rate-limited thrusters: the
-    /// 27 numbers may be followed by the thrusters' memory ([`Actuators::to_flat`], as
-    /// `Solution.state(i)` gives it), which must then be finite.
-    pub fn from_slice_user(y: &[f64], orthonormalize: bool, actuators: usize) -> Result<Self> {
-        if actuators == 0 || y.len() == STATE_DIM {
-            return Self::from_slice_checked(y, orthonormalize);
+    /// [`Self::from_slice_checked`] for a vessel whose components keep `own` states of their
+    /// own (`own_initial`, their values where a run starts) and with `actuators` rate-limited
+    /// thrusters: the 27 numbers alone (the own states then start at `own_initial`), or
+    /// followed by the own states and optionally the thrusters' memory
+    /// ([`Actuators::to_flat`], as `Solution.state(i)` gives it), which must then be finite.
+    pub fn from_slice_user(
+        y: &[f64],
+        orthonormalize: bool,
+        own_initial: &[f64],
+        actuators: usize,
+    ) -> Result<Self> {
+        let own = own_initial.len();
+        if y.len() == STATE_DIM || (own == 0 && actuators == 0) {
+            let mut s = Self::from_slice_checked(y, orthonormalize)?;
+            s.own = own_initial.to_vec();
+            return Ok(s);
         }
-        let with_memory = STATE_DIM + 1 + 2 * actuators;
-        if y.len() != with_memory {
-            return Err(Error::InvalidInput(format!(
-                "a state is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x), or {with_memory} with the memory of the vessel's {actuators} rate-limited thrusters (time, thrusts, angles), got {}",
-                y.len()
-            )));
+        let base = STATE_DIM + own;
+        let with_memory = base + 1 + 2 * actuators;
+        if y.len() != base && (actuators == 0 || y.len() != with_memory) {
+            let mut what = format!(
+                "a state is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x)"
+            );
+            if own > 0 {
+                what += &format!(", or {base} with the components' {own} own states");
+            }
+            if actuators > 0 {
+                what += &format!(
+                    ", or {with_memory} with the memory of the vessel's {actuators} rate-limited thrusters (time, thrusts, angles)"
+                );
+            }
+            return Err(Error::InvalidInput(format!("{what}, got {}", y.len())));
         }
         let mut s = Self::from_slice_checked(&y[..STATE_DIM], orthonormalize)?;
         if let Some(i) = y[STATE_DIM..].iter().position(|v| !v.is_finite()) {
+            let part = if i < own {
+                "the components' own states after the state"
+            } else {
+                "the thrusters' memory after the state"
+            };
             return Err(Error::InvalidInput(format!(
-                "the thrusters' memory after the state must be finite; its entry {i} is {}",
+                "{part} must be finite; entry {} is {}",
+                STATE_DIM + i,
                 y[STATE_DIM + i]
             )));
         }
-        s.act = Actuators::from_flat(&y[STATE_DIM..], actuators)?;
+        s.own = y[STATE_DIM..base].to_vec();
+        if y.len() > base {
+            s.act = Actuators::from_flat(&y[base..], actuators)?;
+        }
         Ok(s)
+    }
+
+    /// The flat form of a state that continues a run: the 27 numbers, the components' own
+    /// states, then the thrusters' memory ([`Self::from_slice_continuing`]'s input).
+    pub fn to_continuing(&self) -> Vec<f64> {
+        let mut v = self.to_vector().as_slice().to_vec();
+        v.extend_from_slice(&self.own);
+        v.extend(self.act.to_flat());
+        v
     }
 
     pub fn from_slice_checked(y: &[f64], orthonormalize: bool) -> Result<Self> {

@@ -23,6 +23,7 @@ use crate::solve::{Account, FieldModel, Model, SplitModel, Work};
 use nalgebra::{Matrix3, SVector, Vector3};
 
 mod memo;
+mod own;
 mod power;
 mod report;
 mod s1;
@@ -97,6 +98,8 @@ pub struct VesselSystem<'a> {
     gave_up: std::sync::Arc<std::sync::atomic::AtomicU8>,
     /// How many rate-limited thrusters the state remembers ([`VesselState::act`]).
     pub actuators: usize,
+    /// How many states the components keep of their own ([`VesselState::own`]).
+    pub own_dim: usize,
     /// The exact flow S2's balance beyond the structural one, per controller state and block
     /// system: computed once, at the upright attitude (`s2.rs`, `exact_balance`).
     exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
@@ -148,6 +151,7 @@ impl<'a> VesselSystem<'a> {
                 .any(|f| f.forced() && !f.forcing_uses_state()),
             gave_up: Default::default(),
             actuators: vessel.actuators(),
+            own_dim: vessel.own_dim(),
             exact_balance: Default::default(),
             s2_memo: Default::default(),
             accounts,
@@ -363,6 +367,7 @@ impl<'a> VesselSystem<'a> {
                     phi_th: z,
                     phi_x: z,
                     act: s.act,
+                    own: vec![0.0; s.own.len()],
                 }
             }
             Flow::S2 => {
@@ -384,6 +389,13 @@ impl<'a> VesselSystem<'a> {
                         fr[i] += g.g[1][i];
                     }
                 }
+                let mut own = Vec::new();
+                if self.own_dim > 0 {
+                    let (rates, tau) = self.own_field(&zs, &s.own);
+                    ft[0] += tau[0];
+                    fr[0] += tau[1];
+                    own = rates;
+                }
                 VesselState {
                     p: ft[0],
                     m: fr[0],
@@ -393,6 +405,7 @@ impl<'a> VesselSystem<'a> {
                     phi_th: fr[2],
                     phi_x: ft[2],
                     act: s.act,
+                    own,
                 }
             }
         }
@@ -494,6 +507,13 @@ impl Model for VesselSystem<'_> {
         }
     }
     fn runge_kutta_refused(&self) -> Option<String> {
+        if self.own_dim > 0 {
+            let names: Vec<_> = self.vessel.own_layout().map(|(f, _)| f.name()).collect();
+            return Some(format!(
+                "the components {} keep states of their own, which the splitting methods integrate in flow S2 with the momenta and the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...)",
+                names.join(", ")
+            ));
+        }
         (self.actuators > 0).then(|| {
             "rate-limited thrusters (thrusters.unit[*].thrust_rate, turn_rate) keep a memory from step to step that the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...), or remove the rate limits".into()
         })
@@ -752,6 +772,7 @@ mod tests {
                 phi_th: if on { te } else { Vector3::zeros() },
                 phi_x: if on { s.x - xr } else { Vector3::zeros() },
                 act: Default::default(),
+                own: Vec::new(),
             }.to_vector();
             let scale = expect.norm();
             prop_assert!((full - expect).norm() <= 1e-13 * scale, "field mismatch {}", (full - expect).norm() / scale);
@@ -760,7 +781,7 @@ mod tests {
             prop_assert!((sum - full).norm() <= 1e-14 * scale, "S1 + S2 != full: {}", (sum - full).norm() / scale);
             // The exact S2 flow has the S2 field as its derivative at h = 0 (centred difference).
             let e = 1e-3;
-            let (mut a, mut b) = (s, s);
+            let (mut a, mut b) = (s.clone(), s.clone());
             sys.flow_s2(&mut a, e, 0.0, on, false, 1);
             sys.flow_s2(&mut b, -e, 0.0, on, false, 1);
             let fd = (a.to_vector() - b.to_vector()) / (2.0 * e);
@@ -936,7 +957,7 @@ mod tests {
         let plain = VesselSystem::new(&base, Some(0.0)).with_linear_flow(LinearFlow::Gauss);
         for stages in 1..=3 {
             let s0 = random_state(&base, [0.3, -0.2, 0.5, 0.1, -0.7, 0.2, 0.4, -0.1]);
-            let (mut a, mut b) = (s0, s0);
+            let (mut a, mut b) = (s0.clone(), s0);
             let wa = forced.flow_s2(&mut a, 0.7, 3.0, true, true, stages);
             let wb = plain.flow_s2(&mut b, 0.7, 3.0, true, true, stages);
             let (va, vb) = (a.to_vector(), b.to_vector());

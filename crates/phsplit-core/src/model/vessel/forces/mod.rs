@@ -19,6 +19,12 @@
 //! **Adding a force**: write `forces/<name>.rs` with a `build` function and a type that
 //! implements [`Force`], and add one line to [`COMPONENTS`].
 //!
+//! **States of its own**: a component may keep states of its own (a subsystem's: a tank's
+//! fluid, a filter, a line's nodes), declared by [`Force::own_states`] and evolving linearly
+//! with the body velocities in flow S2 ([`Force::own_linear`], [`OwnLinear`]); their storage
+//! is a part of H ([`Force::own_storage`]). The vessel lays them out after the body's 27
+//! numbers, integrates them with the momenta and reports them (`port_hamiltonian.rs`).
+//!
 //! **Forcing**: a part of a force that is not affine in the block states at frozen attitude
 //! (the pipe's catenary tension as a function of the hang-off point's position), or that
 //! depends on time (a moving set point), is given by [`Force::add_forcing`] instead, as a
@@ -44,6 +50,7 @@ pub mod damping_quadratic;
 pub mod external;
 pub mod pid;
 pub mod pipe;
+pub mod port_hamiltonian;
 pub mod restoring;
 pub mod spring;
 pub mod thrusters;
@@ -70,6 +77,11 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("current", &["current"], current::build),
     ("pipe", &["pipe"], pipe::build),
     ("spring", &["spring"], spring::build),
+    (
+        "port_hamiltonian",
+        &["port_hamiltonian"],
+        port_hamiltonian::build,
+    ),
     ("waves", &["waves"], waves::build),
     ("wind", &["wind"], wind::build),
 ];
@@ -434,6 +446,35 @@ impl Output {
     }
 }
 
+/// One state a component keeps of its own ([`Force::own_states`]): its name in the results
+/// (unique among the vessel's outputs), CF unit, long name, and value where a run starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OwnState {
+    pub name: String,
+    pub unit: String,
+    pub long_name: String,
+    pub initial: f64,
+}
+
+/// A component's own states in flow S2 ([`Force::own_linear`]), linear in them (`x`, the
+/// component's slice of [`VesselState::own`]) and in the body velocities `ν = (v, ω)`, with
+/// constant matrices: `x' = axx x + axnu ν`; its generalised force on the hull (body frame,
+/// force and moment about the body origin) `τ = fx x + fnu ν`; and the dissipation its account
+/// `account` (an index in [`Force::accounts`], a dissipated account) books,
+/// `[x; ν]ᵀ diss [x; ν]`. The exchange `ντ` with the hull is internal: what `τ` does to the
+/// kinetic energy the component's storage pays, less the dissipation (its contract, checked by
+/// the vessel's ledger tests: `d/dt(storage) = −ντ − [x; ν]ᵀ diss [x; ν]`). The vessel
+/// integrates these rows with the momenta as one linear system in flow S2 (`system/own.rs`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OwnLinear {
+    pub axx: nalgebra::DMatrix<f64>,
+    pub axnu: nalgebra::DMatrix<f64>,
+    pub fx: nalgebra::DMatrix<f64>,
+    pub fnu: nalgebra::DMatrix<f64>,
+    pub account: usize,
+    pub diss: nalgebra::DMatrix<f64>,
+}
+
 /// A force or port of the vessel. See the module documentation for the contract.
 pub trait Force: Debug + Send + Sync {
     /// The component's name (its registration name).
@@ -475,6 +516,24 @@ pub trait Force: Debug + Send + Sync {
     fn storage(&self, _s: &VesselState) -> f64 {
         0.0
     }
+    /// The states it keeps of its own (a subsystem's), laid out after the 27 numbers of the
+    /// body in the order of the components ([`super::Vessel::own_layout`]); none by default.
+    /// They reach the results, files, continued runs and the FMU from this declaration.
+    fn own_states(&self) -> &[OwnState] {
+        &[]
+    }
+    /// How its own states evolve in flow S2 and what they do to the hull ([`OwnLinear`]).
+    /// A component with own states gives them (flow S1 leaves them unchanged).
+    fn own_linear(&self) -> Option<&OwnLinear> {
+        None
+    }
+    /// Energy stored in its own states `x`, a part of H (J).
+    fn own_storage(&self, _x: &[f64]) -> f64 {
+        0.0
+    }
+    /// The quantities it reports from its own states `x` (beyond the states themselves, which
+    /// the vessel reports from [`Force::own_states`]).
+    fn own_outputs(&self, _fr: &Frozen, _z: &[Z3; 2], _x: &[f64], _out: &mut Vec<Output>) {}
     /// Set the state variables it owns from the rest of the state (a consistent start).
     fn init_state(&self, _s: &mut VesselState) {}
     /// Restore, after a step, an invariant of the exact flow that involves the component's own

@@ -188,7 +188,7 @@ mod tests {
                     outer: crate::methods::Outer::Dissipative,
                     ledger: true,
                 };
-                let tr = run(&sys, &method, y0, &opts).unwrap();
+                let tr = run(&sys, &method, y0.clone(), &opts).unwrap();
                 let ks = tr.accounts.iter().position(|a| a.name == "spring").unwrap();
                 assert!(tr.booked.iter().skip(1).any(|w| w.get(ks) != 0.0));
                 for i in 1..tr.t.len() {

@@ -22,6 +22,18 @@ impl VesselSystem<'_> {
         for f in &self.vessel.forces {
             f.outputs(&fr, &z, s, t, &mut out);
         }
+        // The components' own states, as they declare them, and what they report from them.
+        for (f, r) in self.vessel.own_layout() {
+            for (o, v) in f.own_states().iter().zip(&s.own[r.clone()]) {
+                out.push(Output::new(
+                    o.name.clone(),
+                    intern_unit(&o.unit),
+                    o.long_name.clone(),
+                    *v,
+                ));
+            }
+            f.own_outputs(&fr, &z, &s.own[r], &mut out);
+        }
         out
     }
 
@@ -48,6 +60,11 @@ impl VesselSystem<'_> {
             })
             .collect();
         b.add_cross_booked(&z, &mut f);
+        // A subsystem's force on the hull (its account books what it dissipates).
+        for (acc, w) in self.own_wrenches(&z, &s.own) {
+            f[acc][0] += w[0];
+            f[acc][1] += w[1];
+        }
         f.into_iter().map(|[f, m]| (f, m)).collect()
     }
 
@@ -104,4 +121,22 @@ impl VesselSystem<'_> {
         }
         wrench(&fr, &b)
     }
+}
+
+/// A unit as the `&'static str` of an [`Output`]: the usual ones as written, any other
+/// interned (one allocation per distinct unit).
+fn intern_unit(u: &str) -> &'static str {
+    use std::collections::HashSet;
+    use std::sync::{Mutex, OnceLock};
+    static UNITS: OnceLock<Mutex<HashSet<&'static str>>> = OnceLock::new();
+    let mut set = UNITS
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    if let Some(k) = set.get(u) {
+        return k;
+    }
+    let k: &'static str = Box::leak(u.to_string().into_boxed_str());
+    set.insert(k);
+    k
 }

@@ -40,6 +40,9 @@ impl VesselSystem<'_> {
         ledger: bool,
         stages: usize,
     ) -> Work {
+        if self.own_dim > 0 {
+            return self.flow_s2_own(s, h, t, on, ledger, stages);
+        }
         let z0 = self.blocks_of(s);
         let (z1, work) = self.with_s2(s, on, ledger, false, |fr, b| {
             // A forcing part is collocated with the coupled system's solver whether or not the

@@ -179,7 +179,12 @@ impl VesselSystem<'_> {
     /// An account's power `Σ_k ν_kᵀ f_k = Σ R ∘ (z̄_U z̄ᵀ)` as rows `R` on the momentum entries
     /// `U` ([`MOMENTA`]) of `z̄`, with `ν = M⁻¹u` through the full `M⁻¹`. Its integral along S2 is
     /// `Σ R ∘ Y` with `Y` the rows `U` of the Gramian.
-    fn power_rows_full(&self, rows: &[Rows; 2], acc: usize, b: &S2Builder) -> SMatrix<f64, 6, 19> {
+    pub(crate) fn power_rows_full(
+        &self,
+        rows: &[Rows; 2],
+        acc: usize,
+        b: &S2Builder,
+    ) -> SMatrix<f64, 6, 19> {
         let mi = &self.vessel.body.minv_blocks;
         // ν = E z̄ = E_U z̄_U.
         let mut e = SMatrix::<f64, 6, 19>::zeros();

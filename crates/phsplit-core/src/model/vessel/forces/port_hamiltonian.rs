@@ -1,0 +1,437 @@
+//! A linear port-Hamiltonian subsystem coupled to the hull (docs/explanation/components/
+//! port-hamiltonian.md): the paper's §2 class of input–state–output port-Hamiltonian systems in
+//! its linear form, with states of its own.
+//!
+//! Table `[port_hamiltonian]` (optional): `states` (n names), `units` (n CF units, default
+//! `"1"`), the matrices `J` (n×n, skew), `R` (n×n, symmetric positive semidefinite), `Q` (n×n,
+//! symmetric positive definite), `G` (n×k), and optionally `P` (n×k), `S` (k×k, symmetric),
+//! `N` (k×k, skew), all zero by default; `input` (k degrees of freedom of the body velocity,
+//! from surge, sway, heave, roll, pitch, yaw), `point` (m, body frame, default the origin: the
+//! translational inputs are the velocity of that point and the force acts there), `initial`
+//! (n numbers, default zero) and `name` (its account and outputs, default `port_hamiltonian`).
+//!
+//! With `e = Qx` and the input `u = Bν` (`ν = M⁻¹(p, m)`; a translational row of `B` is
+//! `e_iᵀ[I, −r̂]`, a rotational one `e_iᵀ[0, I]`), the subsystem is (van der Schaft, Jeltsema,
+//! *Port-Hamiltonian Systems Theory*, 2014, §4.1, with feedthrough)
+//!
+//! ```text
+//!   x' = (J − R) e + (G − P) u,     y = (G + P)ᵀ e + (N + S) u,
+//! ```
+//!
+//! and its generalised force on the hull is `τ = −Bᵀy` (body force and moment about the body
+//! origin). It is passive when `[[R, P], [Pᵀ, S]] ⪰ 0`, which is checked.
+//!
+//! **Energy statement.** Its storage `½ xᵀQx` is part of H. The hull and the subsystem exchange
+//! `uᵀy` through a power-conserving interconnection, booked to no account; the account `name`
+//! (dissipated) books `[e; u]ᵀ[[R, P], [Pᵀ, S]][e; u] ≥ 0`. Its states are integrated in flow S2
+//! together with the momenta (the coupling is linear in them and in `ν`), by the exact flow or
+//! by Gauss collocation, with the account booked exactly along either (the Gramian, or Gauss
+//! quadrature of the quadratic power); flow S1 leaves them unchanged. The splitting then keeps
+//! the paper's Prop. 2.2 for the whole interconnection: every positive-step method has
+//! `H_n ≤ H_0 + Σ supplied`.
+
+use super::{Force, Frozen, Output, OwnLinear, OwnState};
+use crate::error::Error;
+use crate::flows::collocation::Z3;
+use crate::lie::so3;
+use crate::model::vessel::params::{Params, Range};
+use crate::solve::Account;
+use nalgebra::{DMatrix, DVector, Vector3};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+const T: &str = "port_hamiltonian";
+
+/// The degrees of freedom an input may take, in the order of `ν = (v, ω)`.
+pub const DOFS: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+
+/// Largest number of states (a subsystem larger than this is not a component of a hull).
+pub const MAX_STATES: usize = 64;
+
+/// Largest distance of the input point from the body origin (m).
+pub const MAX_ARM: f64 = 1000.0;
+
+#[derive(Debug)]
+pub struct PortHamiltonian {
+    name: &'static str,
+    accounts: &'static [Account],
+    states: Vec<OwnState>,
+    /// `Q` (for the storage and the outputs), the output map `(G + P)ᵀQ` and `N + S`, `B`.
+    q: DMatrix<f64>,
+    y_x: DMatrix<f64>,
+    y_u: DMatrix<f64>,
+    b: DMatrix<f64>,
+    dofs: Vec<usize>,
+    lin: OwnLinear,
+}
+
+/// The accounts of a subsystem named `name`: interned, one static slice per distinct name
+/// (a sweep over many vessels with the same name makes one).
+fn accounts_of(name: &str) -> (&'static str, &'static [Account]) {
+    static NAMES: OnceLock<Mutex<HashMap<String, (&'static str, &'static [Account])>>> =
+        OnceLock::new();
+    let mut map = NAMES
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    *map.entry(name.to_string()).or_insert_with(|| {
+        let n: &'static str = Box::leak(name.to_string().into_boxed_str());
+        let acc: &'static [Account] = Box::leak(Box::new([Account::dissipated(n)]));
+        (n, acc)
+    })
+}
+
+fn strings(p: &mut Params, key: &str, what: &str) -> crate::Result<Option<Vec<String>>> {
+    let Some(v) = p.take_raw(T, key)? else {
+        return Ok(None);
+    };
+    let bad = || {
+        Error::Parse(format!(
+            "{T}.{key} must be a list of strings ({what}), got {} {v}",
+            v.type_str()
+        ))
+    };
+    let toml::Value::Array(a) = &v else {
+        return Err(bad());
+    };
+    let out: Vec<String> = a
+        .iter()
+        .map(|x| x.as_str().map(str::to_string).ok_or_else(bad))
+        .collect::<crate::Result<_>>()?;
+    p.record_value(T, key, v.clone());
+    Ok(Some(out))
+}
+
+fn is_name(s: &str) -> bool {
+    let mut c = s.chars();
+    c.next().is_some_and(|f| f.is_ascii_alphabetic())
+        && s.chars().all(|x| x.is_ascii_alphanumeric() || x == '_')
+}
+
+/// A matrix of `rows × cols` (`None`: absent and optional, zero).
+fn matrix(
+    p: &mut Params,
+    key: &str,
+    rows: usize,
+    cols: usize,
+    required: bool,
+) -> crate::Result<DMatrix<f64>> {
+    let what = format!("{rows}×{cols}");
+    let raw = p.take_raw(T, key)?;
+    let Some(v) = raw else {
+        if required {
+            return Err(p.missing(T, key, &format!("a {what} matrix, as a list of rows")));
+        }
+        return Ok(DMatrix::zeros(rows, cols));
+    };
+    let toml::Value::Array(a) = &v else {
+        return Err(Error::Parse(format!(
+            "{T}.{key} must be a {what} matrix (a list of {rows} rows of {cols} numbers), got {} {v}",
+            v.type_str()
+        )));
+    };
+    let mut m = DMatrix::zeros(rows, cols);
+    if a.len() != rows {
+        return Err(Error::InvalidInput(format!(
+            "{T}.{key} must be {what} (a list of {rows} rows of {cols} numbers), got {} rows",
+            a.len()
+        )));
+    }
+    for (i, row) in a.iter().enumerate() {
+        let r = row.as_array().filter(|r| r.len() == cols).ok_or_else(|| {
+            Error::InvalidInput(format!(
+                "{T}.{key} must be {what}; its row {i} is {row}, not {cols} numbers"
+            ))
+        })?;
+        for (j, x) in r.iter().enumerate() {
+            m[(i, j)] = x
+                .as_float()
+                .or(x.as_integer().map(|v| v as f64))
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    Error::InvalidInput(format!(
+                        "{T}.{key}[{i}][{j}] must be a finite number, got {x}"
+                    ))
+                })?;
+        }
+    }
+    p.record_value(T, key, v.clone());
+    Ok(m)
+}
+
+/// The largest `|a_ij − s a_ji|` against the matrix's size, for the symmetry (`s = 1`) and
+/// skew-symmetry (`s = −1`) checks: to round-off of the entries as written.
+fn asymmetry(m: &DMatrix<f64>, s: f64) -> f64 {
+    let size = m.amax().max(f64::MIN_POSITIVE);
+    let mut worst: f64 = 0.0;
+    for i in 0..m.nrows() {
+        for j in 0..m.ncols() {
+            worst = worst.max((m[(i, j)] - s * m[(j, i)]).abs());
+        }
+    }
+    worst / size
+}
+
+/// The smallest eigenvalue of a symmetric matrix scaled by its diagonal,
+/// `D^{-1/2} M D^{-1/2}` (`D` its diagonal's magnitudes, 1 where zero), and the largest
+/// magnitude: the states have units of their own, and the scaled matrix's eigenvalues do not
+/// depend on them (a diagonal `Q = diag(C, 1/A)` is definite whatever C and A are).
+fn min_eigenvalue(m: &DMatrix<f64>) -> (f64, f64) {
+    let d: Vec<f64> = (0..m.nrows())
+        .map(|i| {
+            let a = m[(i, i)].abs().sqrt();
+            if a > 0.0 {
+                a
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let sym = DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| {
+        0.5 * (m[(i, j)] + m[(j, i)]) / (d[i] * d[j])
+    });
+    let ev = sym.symmetric_eigenvalues();
+    let lo = ev.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = ev.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    (lo, hi)
+}
+
+pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+    p.declare(T);
+    if !p.has(T) {
+        return Ok(None);
+    }
+    let name = match p.take_raw(T, "name")? {
+        None => T.to_string(),
+        Some(toml::Value::String(s)) if is_name(&s) => s,
+        Some(v) => {
+            return Err(Error::InvalidInput(format!(
+                "{T}.name must be a name of letters, digits and underscores that starts with a letter (it names the subsystem's account and outputs), got {v}"
+            )))
+        }
+    };
+    p.record_value(T, "name", toml::Value::String(name.clone()));
+    let states = strings(p, "states", "the names of the subsystem's states")?
+        .ok_or_else(|| p.missing(T, "states", "a list of state names"))?;
+    let n = states.len();
+    if n == 0 || n > MAX_STATES {
+        return Err(Error::InvalidInput(format!(
+            "{T}.states must name between 1 and {MAX_STATES} states, got {n}"
+        )));
+    }
+    for (i, s) in states.iter().enumerate() {
+        if !is_name(s) {
+            return Err(Error::InvalidInput(format!(
+                "{T}.states[{i}] must be a name of letters, digits and underscores that starts with a letter, got {s:?}"
+            )));
+        }
+        if states[..i].contains(s) {
+            return Err(Error::InvalidInput(format!(
+                "{T}.states names {s:?} twice; each state needs its own name"
+            )));
+        }
+    }
+    let units = strings(p, "units", "a CF unit per state")?.unwrap_or_else(|| vec!["1".into(); n]);
+    if units.len() != n {
+        return Err(Error::InvalidInput(format!(
+            "{T}.units must give one unit per state ({n}), got {}",
+            units.len()
+        )));
+    }
+    let input = strings(p, "input", "degrees of freedom of the body velocity")?
+        .ok_or_else(|| p.missing(T, "input", "a list of degrees of freedom"))?;
+    let mut dofs = Vec::new();
+    for (i, d) in input.iter().enumerate() {
+        let Some(k) = DOFS.iter().position(|x| x == d) else {
+            return Err(Error::InvalidInput(format!(
+                "{T}.input[{i}] must be one of {}, got {d:?}",
+                DOFS.map(|x| format!("'{x}'")).join(", ")
+            )));
+        };
+        if dofs.contains(&k) {
+            return Err(Error::InvalidInput(format!(
+                "{T}.input names {d:?} twice; each degree of freedom is one input"
+            )));
+        }
+        dofs.push(k);
+    }
+    let k = dofs.len();
+    if k == 0 {
+        return Err(Error::InvalidInput(format!(
+            "{T}.input must name at least one degree of freedom ({})",
+            DOFS.join(", ")
+        )));
+    }
+    let point = p.vec3(T, "point", Some([0.0; 3]), "m, body frame", Range::Finite)?;
+    if let Some(i) = point.iter().position(|r| r.abs() > MAX_ARM) {
+        return Err(Error::InvalidInput(format!(
+            "{T}.point[{i}] must lie within {MAX_ARM} m of the body origin (m, body frame), got {}",
+            point[i]
+        )));
+    }
+    let j = matrix(p, "J", n, n, true)?;
+    let r = matrix(p, "R", n, n, true)?;
+    let q = matrix(p, "Q", n, n, true)?;
+    let g = matrix(p, "G", n, k, true)?;
+    let pm = matrix(p, "P", n, k, false)?;
+    let s = matrix(p, "S", k, k, false)?;
+    let nm = matrix(p, "N", k, k, false)?;
+    // Round-off of the entries as written: a matrix given to 12 digits passes.
+    const SYM: f64 = 1e-12;
+    for (key, m, sign, what) in [
+        ("J", &j, -1.0, "skew-symmetric (J = −Jᵀ)"),
+        ("R", &r, 1.0, "symmetric (R = Rᵀ)"),
+        ("Q", &q, 1.0, "symmetric (Q = Qᵀ)"),
+        ("S", &s, 1.0, "symmetric (S = Sᵀ)"),
+        ("N", &nm, -1.0, "skew-symmetric (N = −Nᵀ)"),
+    ] {
+        let a = asymmetry(m, sign);
+        if a > SYM {
+            return Err(Error::InvalidInput(format!(
+                "{T}.{key} must be {what}: its largest |a_ij {} a_ji| is {a:.3e} of its largest entry (allowed: ≤ {SYM:e})",
+                if sign > 0.0 { "−" } else { "+" }
+            )));
+        }
+    }
+    let (lo, hi) = min_eigenvalue(&q);
+    if !(lo > 1e-12 * hi) {
+        return Err(Error::InvalidInput(format!(
+            "{T}.Q must be symmetric positive definite (the storage ½ xᵀQx): its smallest eigenvalue is {lo:.6e}, its largest {hi:.6e} (of Q scaled by its diagonal, D^(-1/2) Q D^(-1/2); allowed: smallest > 1e-12 × largest)"
+        )));
+    }
+    let (lo, hi) = min_eigenvalue(&r);
+    if lo < -1e-12 * hi.max(f64::MIN_POSITIVE) {
+        return Err(Error::InvalidInput(format!(
+            "{T}.R must be symmetric positive semidefinite (a dissipation): its smallest eigenvalue scaled by its diagonal is {lo:.6e} (allowed: ≥ 0)"
+        )));
+    }
+    let mut d = DMatrix::zeros(n + k, n + k);
+    d.view_mut((0, 0), (n, n)).copy_from(&r);
+    d.view_mut((0, n), (n, k)).copy_from(&pm);
+    d.view_mut((n, 0), (k, n)).copy_from(&pm.transpose());
+    d.view_mut((n, n), (k, k)).copy_from(&s);
+    let (lo, hi) = min_eigenvalue(&d);
+    if lo < -1e-12 * hi.max(f64::MIN_POSITIVE) {
+        return Err(Error::InvalidInput(format!(
+            "{T}: [[R, P], [Pᵀ, S]] must be positive semidefinite for the subsystem to be passive: its smallest eigenvalue scaled by its diagonal is {lo:.6e} (allowed: ≥ 0; with P = 0 this needs S ⪰ 0)"
+        )));
+    }
+    let initial = match p.rows(T, "initial", 1, "the states' units", Range::Finite)? {
+        None => vec![0.0; n],
+        Some(v) if v.len() == n => v.into_iter().map(|r| r[0]).collect(),
+        Some(v) => {
+            return Err(Error::InvalidInput(format!(
+                "{T}.initial must give one value per state ({n}), got {}",
+                v.len()
+            )))
+        }
+    };
+    let (name, accounts) = accounts_of(&name);
+    // u = Bν.
+    let rh = so3::hat(&Vector3::from(point));
+    let mut b = DMatrix::zeros(k, 6);
+    for (i, &dof) in dofs.iter().enumerate() {
+        if dof < 3 {
+            b[(i, dof)] = 1.0;
+            for c in 0..3 {
+                b[(i, 3 + c)] = -rh[(dof, c)];
+            }
+        } else {
+            b[(i, dof)] = 1.0;
+        }
+    }
+    let y_x = (&g + &pm).transpose() * &q;
+    let y_u = &nm + &s;
+    let mut t = DMatrix::zeros(n + k, n + 6);
+    t.view_mut((0, 0), (n, n)).copy_from(&q);
+    t.view_mut((n, n), (k, 6)).copy_from(&b);
+    let lin = OwnLinear {
+        axx: (&j - &r) * &q,
+        axnu: (&g - &pm) * &b,
+        fx: -b.transpose() * &y_x,
+        fnu: -b.transpose() * &y_u * &b,
+        account: 0,
+        diss: t.transpose() * &d * &t,
+    };
+    let states = states
+        .iter()
+        .zip(units)
+        .zip(initial)
+        .map(|((s, unit), initial)| OwnState {
+            name: format!("{name}_{s}"),
+            long_name: format!("state {s} of the port-Hamiltonian subsystem {name}"),
+            unit,
+            initial,
+        })
+        .collect();
+    Ok(Some(Arc::new(PortHamiltonian {
+        name,
+        accounts,
+        states,
+        q,
+        y_x,
+        y_u,
+        b,
+        dofs,
+        lin,
+    })))
+}
+
+impl PortHamiltonian {
+    /// The input `u = Bν` and the output `y` at the states `x` and the velocities `nu`.
+    fn io(&self, x: &[f64], nu: &[Vector3<f64>; 2]) -> (DVector<f64>, DVector<f64>) {
+        let v = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
+        let u = &self.b * v;
+        let y = &self.y_x * DVector::from_column_slice(x) + &self.y_u * &u;
+        (u, y)
+    }
+}
+
+impl Force for PortHamiltonian {
+    fn name(&self) -> &'static str {
+        T
+    }
+    fn accounts(&self) -> &'static [Account] {
+        self.accounts
+    }
+    fn add_s2(&self, _fr: &Frozen, _b: &mut super::S2Builder) {}
+    fn own_states(&self) -> &[OwnState] {
+        &self.states
+    }
+    fn own_linear(&self) -> Option<&OwnLinear> {
+        Some(&self.lin)
+    }
+    fn own_storage(&self, x: &[f64]) -> f64 {
+        let x = DVector::from_column_slice(x);
+        0.5 * x.dot(&(&self.q * &x))
+    }
+    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], out: &mut Vec<Output>) {
+        let nu = fr.nu(z);
+        let (u, y) = self.io(x, &nu);
+        let name = self.name;
+        out.push(Output::new(
+            format!("{name}_storage"),
+            "J",
+            format!("energy stored in the port-Hamiltonian subsystem {name}, ½ xᵀQx"),
+            self.own_storage(x),
+        ));
+        out.push(Output::new(
+            format!("{name}_power"),
+            "W",
+            format!("power from the hull into the port-Hamiltonian subsystem {name}, yᵀu"),
+            u.dot(&y),
+        ));
+        for (i, &dof) in self.dofs.iter().enumerate() {
+            let unit = if dof < 3 { "N" } else { "N m" };
+            out.push(Output::new(
+                format!("{name}_force_{}", DOFS[dof]),
+                unit,
+                format!(
+                    "generalised force of the port-Hamiltonian subsystem {name} on the hull in {}, −y",
+                    DOFS[dof]
+                ),
+                -y[i],
+            ));
+        }
+    }
+}

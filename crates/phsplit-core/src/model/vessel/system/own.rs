@@ -1,0 +1,425 @@
+//! Flow S2 with the components' own states (a linear port-Hamiltonian subsystem's; forces/
+//! port_hamiltonian.rs): one dense linear system `w' = A w (+ forcing)` on
+//! `w = (z̄₁…₁₈, x, 1)`, the body's two block systems (`z̄` as in `s2/coupled.rs`), the own
+//! states `x` ([`VesselState::own`]) and the constant. The own states' rows and their force on
+//! the momenta are the components' [`OwnLinear`], with `ν = M⁻¹u` through the full `M⁻¹`.
+//!
+//! The exact flow is the matrix exponential (nalgebra's Padé scaling and squaring, Higham,
+//! SIAM J. Matrix Anal. Appl. 26 (2005) 1179–1193) of the balanced system, and the ledger the
+//! Gramian `∫ w wᵀ dt` over the sub-step by Van Loan's block exponential (C. F. Van Loan, IEEE
+//! Trans. Autom. Control 23 (1978) 395–404): every account's energy is a quadratic form in
+//! `w`, so its integral is exact along the flow. Gauss collocation (with a forcing part,
+//! iterated to a fixed point; or with [`LinearFlow::Gauss`]) solves the dense stage system
+//! once per sub-step and books each account's power at the stages with the Gauss weights,
+//! exact for the collocation polynomial of a quadratic storage (Hairer, Lubich, Wanner,
+//! *Geometric Numerical Integration*, §IV.2). Both are energy-dissipative for a dissipative S2,
+//! so the composition keeps the paper's Prop. 2.2 (and Remark 2.3 for the collocation).
+
+use super::super::forces::{Forcing, Frozen, OwnLinear, S2Builder};
+use super::super::state::VesselState;
+use super::s2::augmented;
+use super::{GaveUp, LinearFlow, VesselSystem};
+use crate::flows::collocation::{self as gauss, Z3};
+use crate::solve::Work;
+use nalgebra::{DMatrix, DVector, Vector3};
+
+/// The momentum entries `u_t`, `u_r` of `w` (as of `z̄`).
+const MOMENTA: [usize; 6] = [0, 1, 2, 9, 10, 11];
+
+/// Most fixed-point passes over the forcing in one sub-step.
+const MAX_PASSES: usize = 200;
+
+impl VesselSystem<'_> {
+    /// Flow S2 over `h` from time `t` for a vessel whose components keep states of their own:
+    /// the body's block states and the own states together (module documentation).
+    pub(super) fn flow_s2_own(
+        &self,
+        s: &mut VesselState,
+        h: f64,
+        t: f64,
+        on: bool,
+        ledger: bool,
+        stages: usize,
+    ) -> Work {
+        let z0 = self.blocks_of(s);
+        let w0 = self.pack(&z0, &s.own);
+        let (w1, work) = self.with_s2(s, on, ledger, false, |fr, b| {
+            let a = self.dense(b);
+            if self.forced || self.linear == LinearFlow::Gauss {
+                self.dense_collocation(fr, b, &a, &w0, h, t, stages)
+            } else {
+                self.dense_exact(b, &a, &w0, h)
+            }
+        });
+        let (z1, x1) = self.unpack(&w1);
+        self.set_blocks(s, &z1);
+        s.own = x1;
+        work
+    }
+
+    fn dim(&self) -> usize {
+        19 + self.own_dim
+    }
+
+    fn pack(&self, z: &[Z3; 2], x: &[f64]) -> DVector<f64> {
+        let mut w = DVector::zeros(self.dim());
+        for k in 0..2 {
+            for i in 0..3 {
+                w.rows_mut(9 * k + 3 * i, 3).copy_from(&z[k][i]);
+            }
+        }
+        w.rows_mut(18, x.len()).copy_from_slice(x);
+        w[self.dim() - 1] = 1.0;
+        w
+    }
+
+    fn unpack(&self, w: &DVector<f64>) -> ([Z3; 2], Vec<f64>) {
+        let z = std::array::from_fn(|k| {
+            std::array::from_fn(|i| Vector3::from_column_slice(&w.as_slice()[9 * k + 3 * i..][..3]))
+        });
+        (z, w.as_slice()[18..18 + self.own_dim].to_vec())
+    }
+
+    /// `ν = E w` (6 × N), through the full `M⁻¹`.
+    fn velocity_map(&self) -> DMatrix<f64> {
+        let mi = &self.vessel.body.minv_blocks;
+        let mut e = DMatrix::zeros(6, self.dim());
+        for j in 0..2 {
+            for l in 0..2 {
+                for r in 0..3 {
+                    for c in 0..3 {
+                        e[(3 * j + r, 9 * l + c)] = mi[j][l][(r, c)];
+                    }
+                }
+            }
+        }
+        e
+    }
+
+    /// The components with own states, their linear parts and their columns in `w`.
+    fn own_parts(&self) -> Vec<(usize, &OwnLinear, std::ops::Range<usize>)> {
+        self.vessel
+            .own_layout()
+            .filter_map(|(f, r)| {
+                let base = self
+                    .vessel
+                    .forces
+                    .iter()
+                    .position(|g| std::ptr::eq(g.as_ref(), f.as_ref()))
+                    .map_or(0, |i| self.bases[i]);
+                f.own_linear()
+                    .map(|l| (base + l.account, l, 18 + r.start..18 + r.end))
+            })
+            .collect()
+    }
+
+    /// The own states' rates and their generalised force on the hull (body frame) at the block
+    /// states `z` and own states `x` (flow S2's field, eq. 41, for them).
+    pub(super) fn own_field(&self, z: &[Z3; 2], x: &[f64]) -> (Vec<f64>, [Vector3<f64>; 2]) {
+        let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
+        let nu = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
+        let mut rates = vec![0.0; x.len()];
+        let mut tau = DVector::<f64>::zeros(6);
+        for (_, l, r) in self.own_parts() {
+            let (a, b) = (r.start - 18, r.end - 18);
+            let xi = DVector::from_column_slice(&x[a..b]);
+            let d = &l.axx * &xi + &l.axnu * &nu;
+            rates[a..b].copy_from_slice(d.as_slice());
+            tau += &l.fx * &xi + &l.fnu * &nu;
+        }
+        (
+            rates,
+            [
+                Vector3::new(tau[0], tau[1], tau[2]),
+                Vector3::new(tau[3], tau[4], tau[5]),
+            ],
+        )
+    }
+
+    /// Each own-state component's account with its force and moment on the hull (body frame).
+    pub(super) fn own_wrenches(&self, z: &[Z3; 2], x: &[f64]) -> Vec<(usize, [Vector3<f64>; 2])> {
+        let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
+        let nu = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
+        self.own_parts()
+            .into_iter()
+            .map(|(acc, l, r)| {
+                let xi = DVector::from_column_slice(&x[r.start - 18..r.end - 18]);
+                let tau = &l.fx * &xi + &l.fnu * &nu;
+                (
+                    acc,
+                    [
+                        Vector3::new(tau[0], tau[1], tau[2]),
+                        Vector3::new(tau[3], tau[4], tau[5]),
+                    ],
+                )
+            })
+            .collect()
+    }
+
+    /// The dense matrix `A` of flow S2 with the own states.
+    fn dense(&self, b: &S2Builder) -> DMatrix<f64> {
+        let n = self.dim();
+        let c = n - 1;
+        let full = augmented(b);
+        let mut a = DMatrix::zeros(n, n);
+        for i in 0..18 {
+            for j in 0..18 {
+                a[(i, j)] = full[(i, j)];
+            }
+            a[(i, c)] = full[(i, 18)];
+        }
+        let e = self.velocity_map();
+        for (_, l, r) in self.own_parts() {
+            let m = r.len();
+            let mut rows = a.view_mut((r.start, r.start), (m, m));
+            rows += &l.axx;
+            let xnu = &l.axnu * &e;
+            let mut rows = a.rows_mut(r.start, m);
+            rows += &xnu;
+            let fnu = &l.fnu * &e;
+            for (i, &mi) in MOMENTA.iter().enumerate() {
+                for j in 0..m {
+                    a[(mi, r.start + j)] += l.fx[(i, j)];
+                }
+                for j in 0..n {
+                    a[(mi, j)] += fnu[(i, j)];
+                }
+            }
+        }
+        a
+    }
+
+    /// Each account's power as a quadratic form `wᵀ W w` (one `W` per account, not symmetric).
+    fn power_forms(&self, b: &S2Builder) -> Vec<DMatrix<f64>> {
+        let n = self.dim();
+        let c = n - 1;
+        let col = |j: usize| if j == 18 { c } else { j };
+        let mut out = vec![DMatrix::zeros(n, n); self.accounts.len()];
+        if let Some(booked) = &b.booked {
+            for (acc, w) in out.iter_mut().enumerate() {
+                let r = self.power_rows_full(&booked[acc], acc, b);
+                let sign = self.sign(acc);
+                for i in 0..6 {
+                    for j in 0..19 {
+                        w[(MOMENTA[i], col(j))] += sign * r[(i, j)];
+                    }
+                }
+            }
+        }
+        let e = self.velocity_map();
+        for (acc, l, r) in self.own_parts() {
+            // [x; ν] = T w; the dissipation is booked as a positive number.
+            let m = r.len();
+            let mut t = DMatrix::zeros(m + 6, n);
+            for i in 0..m {
+                t[(i, r.start + i)] = 1.0;
+            }
+            t.rows_mut(m, 6).copy_from(&e);
+            out[acc] += t.transpose() * &l.diss * &t;
+        }
+        out
+    }
+
+    /// The balancing `w = S w̃`: the block systems' structural one, then Osborne's iteration
+    /// by powers of two (exact in floating point), as for the coupled system.
+    fn dense_balance(&self, b: &S2Builder, a: &DMatrix<f64>) -> DVector<f64> {
+        let n = self.dim();
+        let md = self.vessel.body.mass_matrix.diagonal();
+        let mut sc = DVector::from_element(n, 1.0);
+        for k in 0..2 {
+            let minv = Vector3::from_fn(|i, _| 1.0 / md[3 * k + i]);
+            let sk = super::s2::balance(&b.sys[k], &minv);
+            for i in 0..9 {
+                sc[9 * k + i] = sk[i];
+            }
+        }
+        let mut m = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * sc[j] / sc[i]);
+        for _ in 0..20 {
+            let mut done = true;
+            for i in 0..n - 1 {
+                let (mut r, mut col) = (0.0, 0.0);
+                for j in 0..n {
+                    if j != i {
+                        r += m[(i, j)].abs();
+                        col += m[(j, i)].abs();
+                    }
+                }
+                if r == 0.0 || col == 0.0 {
+                    continue;
+                }
+                let f = crate::flows::affine::nearest_power_of_two((r / col).sqrt());
+                if f != 1.0 && (col * f + r / f) < 0.95 * (col + r) {
+                    done = false;
+                    sc[i] *= f;
+                    for j in 0..n {
+                        m[(i, j)] /= f;
+                        m[(j, i)] *= f;
+                    }
+                }
+            }
+            if done {
+                break;
+            }
+        }
+        sc
+    }
+
+    /// The exact flow and, with the ledger, each account's energy from the Gramian.
+    fn dense_exact(
+        &self,
+        b: &S2Builder,
+        a: &DMatrix<f64>,
+        w0: &DVector<f64>,
+        h: f64,
+    ) -> (DVector<f64>, Work) {
+        let n = self.dim();
+        let sc = self.dense_balance(b, a);
+        let ab = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * sc[j] / sc[i]);
+        let wb = w0.component_div(&sc);
+        if b.booked.is_none() {
+            let e = (&ab * h).exp();
+            return ((e * wb).component_mul(&sc), Work::default());
+        }
+        // exp([[−Ã, w̃w̃ᵀ], [0, Ãᵀ]] h) = [[·, F12], [0, F22]], F22 = e^{Ãᵀh},
+        // ∫₀ʰ e^{Ãs} w̃w̃ᵀ e^{Ãᵀs} ds = F22ᵀ F12.
+        let mut big = DMatrix::zeros(2 * n, 2 * n);
+        big.view_mut((0, 0), (n, n)).copy_from(&(-&ab * h));
+        big.view_mut((0, n), (n, n))
+            .copy_from(&(&wb * wb.transpose() * h));
+        big.view_mut((n, n), (n, n))
+            .copy_from(&(ab.transpose() * h));
+        let f = big.exp();
+        let f22t = f.view((n, n), (n, n)).transpose();
+        let gram = &f22t * f.view((0, n), (n, n));
+        let w1 = (&f22t * &wb).component_mul(&sc);
+        let forms = self.power_forms(b);
+        let work = Work::from_fn(self.accounts.len(), |acc| {
+            let w = &forms[acc];
+            let mut e = 0.0;
+            for i in 0..n {
+                for j in 0..n {
+                    if w[(i, j)] != 0.0 {
+                        e += w[(i, j)] * gram[(i, j)] * sc[i] * sc[j];
+                    }
+                }
+            }
+            e
+        });
+        (w1, work)
+    }
+
+    /// Gauss collocation with `s` stages on the balanced dense system, the forcing iterated to a
+    /// fixed point; the ledger by Gauss quadrature.
+    #[allow(clippy::too_many_arguments)]
+    fn dense_collocation(
+        &self,
+        fr: &Frozen,
+        b: &S2Builder,
+        a: &DMatrix<f64>,
+        w0: &DVector<f64>,
+        h: f64,
+        t: f64,
+        s: usize,
+    ) -> (DVector<f64>, Work) {
+        let n = self.dim();
+        let nan = (DVector::from_element(n, f64::NAN), Work::default());
+        let sc = self.dense_balance(b, a);
+        let ab = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * sc[j] / sc[i]);
+        let wb = w0.component_div(&sc);
+        let (ta, bw) = gauss::tableau(s);
+        let nodes: Vec<f64> = (0..s).map(|i| ta[i].iter().sum()).collect();
+        // (I − h 𝒜 ⊗ Ã) Y = 1 ⊗ w̃0 + h (𝒜 ⊗ I) g̃.
+        let mut m = DMatrix::identity(s * n, s * n);
+        for i in 0..s {
+            for j in 0..s {
+                let mut blk = m.view_mut((i * n, j * n), (n, n));
+                blk -= &ab * (h * ta[i][j]);
+            }
+        }
+        let lu = m.lu();
+        let zero_g = || DVector::zeros(n);
+        let mut gt: Vec<DVector<f64>> = (0..s).map(|_| zero_g()).collect();
+        let mut forcings: Vec<Forcing> = (0..s).map(|_| Forcing::new()).collect();
+        let mut ys: Vec<DVector<f64>> = vec![wb.clone(); s];
+        let unscale = |y: &DVector<f64>| y.component_mul(&sc);
+        let mut last_change = f64::INFINITY;
+        for pass in 0..MAX_PASSES {
+            if self.forced {
+                for i in 0..s {
+                    let (z, _) = self.unpack(&unscale(&ys[i]));
+                    forcings[i].clear();
+                    self.add_forcing_of(fr, t + nodes[i] * h, &z, None, &mut forcings[i]);
+                    let g = &forcings[i].g;
+                    let mut v = zero_g();
+                    for k in 0..2 {
+                        for c in 0..3 {
+                            for r in 0..3 {
+                                let idx = 9 * k + 3 * c + r;
+                                v[idx] = g[k][c][r] / sc[idx];
+                            }
+                        }
+                    }
+                    gt[i] = v;
+                }
+            }
+            let mut rhs = DVector::zeros(s * n);
+            for i in 0..s {
+                let mut r = wb.clone();
+                for j in 0..s {
+                    r += &gt[j] * (h * ta[i][j]);
+                }
+                rhs.rows_mut(i * n, n).copy_from(&r);
+            }
+            let Some(y) = lu.solve(&rhs) else {
+                self.give_up(GaveUp::Singular);
+                return nan;
+            };
+            let mut change: f64 = 0.0;
+            for i in 0..s {
+                let yi = y.rows(i * n, n).into_owned();
+                let size = yi.amax().max(f64::MIN_POSITIVE);
+                change = change.max((&yi - &ys[i]).amax() / size);
+                ys[i] = yi;
+            }
+            if !self.forced || change <= 4.0 * f64::EPSILON {
+                break;
+            }
+            if pass > 3 && change >= last_change {
+                // Stalled at round-off.
+                if change <= 1e-12 {
+                    break;
+                }
+                self.give_up(GaveUp::Forcing);
+                return nan;
+            }
+            if pass + 1 == MAX_PASSES {
+                self.give_up(GaveUp::Forcing);
+                return nan;
+            }
+            last_change = change;
+        }
+        let mut w1 = wb.clone();
+        for i in 0..s {
+            w1 += (&ab * &ys[i] + &gt[i]) * (h * bw[i]);
+        }
+        let w1 = unscale(&w1);
+        let mut work = Work::default();
+        if b.booked.is_some() {
+            let forms = self.power_forms(b);
+            for i in 0..s {
+                let y = unscale(&ys[i]);
+                let p = Work::from_fn(self.accounts.len(), |acc| y.dot(&(&forms[acc] * &y)));
+                let mut p = p;
+                if self.forced {
+                    let (z, _) = self.unpack(&y);
+                    p += self.forcing_power(&[&forcings[i]], &z);
+                }
+                work += p.scaled(h * bw[i]);
+            }
+        }
+        if !w1.iter().all(|v| v.is_finite()) {
+            return nan;
+        }
+        (w1, work)
+    }
+}
