@@ -256,7 +256,7 @@ def test_the_account_books_the_dissipation_and_the_outputs_are_the_port():
         want = simpson(np.array([f.ph_dissipation(yi) for yi in y]), x=t)
         booked = s.ledger.by_account[name_of(table)]
         assert np.all(booked[1:] >= 0.0), case
-        assert abs(booked[1:].sum() - want) <= 1e-6 * want, (case, booked[1:].sum(), want)
+        assert abs(booked[1:].sum() - want) <= 1e-9 * want, (case, booked[1:].sum(), want)
         assert s.ledger.relative_residual().max() < 1e-10, case
         xc = own_states(s, table)
         u, yc, storage = port(table, xc, np.hstack([s.v, s.w]))
