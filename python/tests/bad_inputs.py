@@ -923,3 +923,38 @@ CATALOGUE += [
         scenario('[environment.wind]\nspeed = 15.0\nship_type = "offshore supply vessel"\nfrontal_area = 200.0\n'
                  'lateral_area = 600.0\nlength = 8000.0\n'), E, ("environment.wind.length", "500 m", "8000")),
 ]
+
+# ------------------------------------------------------------------------------------------
+# a linear port-Hamiltonian subsystem (van der Schaft & Jeltsema 2014, §4.1): its matrices
+
+_PH = {"states": '["q", "pi"]', "J": "[[0.0, -1.0], [1.0, 0.0]]", "R": "[[0.0, 0.0], [0.0, 0.1]]",
+       "Q": "[[2.0, 0.0], [0.0, 1.0]]", "G": "[[1.0], [0.0]]", "input": '["roll"]'}
+
+
+def _ph(**keys: str) -> Callable[[], object]:
+    """The paper's vessel with a [port_hamiltonian] table: a valid two-state subsystem on roll,
+    with ``keys`` (TOML values as text) in place of or besides its own."""
+    table = "".join(f"{k} = {v}\n" for k, v in {**_PH, **keys}.items())
+    return vessel_with("[initial]", f"[port_hamiltonian]\n{table}[initial]")
+
+
+CATALOGUE += [
+    Bad("port-Hamiltonian J that is not skew", _ph(J="[[0.0, -1.0], [0.5, 0.0]]"), E, ("port_hamiltonian.J", "skew")),
+    Bad("port-Hamiltonian R that is not symmetric", _ph(R="[[0.0, 0.1], [0.0, 0.1]]"), E,
+        ("port_hamiltonian.R", "symmetric")),
+    Bad("port-Hamiltonian R that is not positive semidefinite", _ph(R="[[0.0, 0.0], [0.0, -0.1]]"), E,
+        ("port_hamiltonian.R", "semidefinite")),
+    Bad("port-Hamiltonian Q that is only semidefinite", _ph(Q="[[2.0, 0.0], [0.0, 0.0]]"), E,
+        ("port_hamiltonian.Q", "positive definite")),
+    Bad("port-Hamiltonian Q that is not symmetric", _ph(Q="[[2.0, 0.5], [0.0, 1.0]]"), E,
+        ("port_hamiltonian.Q", "symmetric")),
+    Bad("port-Hamiltonian G with a row per state too many", _ph(G="[[1.0], [0.0], [0.0]]"), E,
+        ("port_hamiltonian.G", "2")),
+    Bad("port-Hamiltonian J of another size than the states", _ph(J="[[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]"),
+        E, ("port_hamiltonian.J", "2")),
+    Bad("port-Hamiltonian input of an unknown degree of freedom", _ph(input='["rol"]'), E,
+        ("port_hamiltonian.input", "rol", "sway")),
+    Bad("port-Hamiltonian states named twice", _ph(states='["q", "q"]'), E, ("port_hamiltonian.states", "q")),
+    Bad("port-Hamiltonian dissipation block [[R, P], [Pᵀ, S]] that is indefinite",
+        _ph(P="[[0.0], [1.0]]", S="[[1.0]]"), E, ("port_hamiltonian", "P", "S", "semidefinite")),
+]

@@ -1,6 +1,8 @@
 """An independent reference for the vessel, for the tests: eq. (39) of the paper written again in
 numpy, from docs/model.md §2 (and the loads of §5), integrated by scipy's DOP853 at
-tight tolerance.
+tight tolerance. A linear port-Hamiltonian subsystem with states of its own (the vessel file's
+[port_hamiltonian] table) is written from van der Schaft & Jeltsema, Port-Hamiltonian Systems
+Theory (2014), §4.1: the input-state-output system with feedthrough.
 
 Nothing here calls phsplit's integrators or its Rust vector field; only the initial state and
 the parameters are shared. The tests use it to check the splitting methods against a
@@ -30,7 +32,9 @@ def pi_e(th):
 
 
 class Field:
-    """y' of eq. (39) with the PID control (29)–(33); y = (p, m, Q col-major, mu, x, phi_th, phi_x)."""
+    """y' of eq. (39) with the PID control (29)–(33); y = (p, m, Q col-major, mu, x, phi_th, phi_x),
+    then the set point's filter (18, with a [setpoint]), then a port-Hamiltonian subsystem's
+    states (n, with a [port_hamiltonian])."""
 
     def __init__(self, params: dict, control_on: bool):
         h, c = params["vessel"], params["control"]
@@ -87,6 +91,27 @@ class Field:
         # a slowly varying current: linear between the rows of its time table, constant outside
         self.vc_table = (np.array(cur["times"], float), np.array(cur["velocities"], float)) \
             if cur and "times" in cur else None
+        ph = params.get("port_hamiltonian")
+        # a linear port-Hamiltonian subsystem (van der Schaft & Jeltsema 2014, §4.1), its n states
+        # after the set point's filter: x' = (J - R) Qc x + (G - P) u, y = (G + P)^T Qc x + (N + S) u,
+        # its input u = B nu the hull's velocities at its point (v + w x r) and about its axes, and
+        # its load on the hull tau = -B^T y (the force at the point, its moment r x f)
+        self.ph = None
+        if ph:
+            n = len(ph["states"])
+            k = len(ph["input"])
+            mat = lambda key, shape: np.array(ph[key], float).reshape(shape) if key in ph else np.zeros(shape)  # noqa: E731
+            r = np.array(ph.get("point", [0.0] * 3), float)
+            B = np.zeros((k, 6))
+            for i, dof in enumerate(ph["input"]):
+                j = ("surge", "sway", "heave", "roll", "pitch", "yaw").index(dof)
+                if j < 3:
+                    B[i, :3], B[i, 3:] = np.eye(3)[j], -hat(r)[j]
+                else:
+                    B[i, j] = 1.0
+            self.ph = {"J": mat("J", (n, n)), "R": mat("R", (n, n)), "Q": mat("Q", (n, n)), "G": mat("G", (n, k)),
+                       "P": mat("P", (n, k)), "S": mat("S", (k, k)), "N": mat("N", (k, k)), "B": B,
+                       "at": 45 if sp else 27, "n": n}
 
     def external(self, Q):
         """Body-frame force and moment (about the body origin) of the constant external load."""
@@ -226,6 +251,20 @@ class Field:
             slope = np.zeros(6)
         return rows[k] + slope * max(t - times[k], 0.0), slope
 
+    def ph_port(self, y):
+        """The subsystem's (x, Qc x, u, y) at state y: its states, co-energy variables, input and output."""
+        c = self.ph
+        xc = y[c["at"]:c["at"] + c["n"]]
+        e = c["Q"] @ xc
+        u = c["B"] @ np.concatenate([y[0:3] / self.mv, y[3:6] / self.T])
+        return xc, e, u, (c["G"] + c["P"]).T @ e + (c["N"] + c["S"]) @ u
+
+    def ph_dissipation(self, y):
+        """The subsystem's dissipation rate [Qc x; u]^T [[R, P], [P^T, S]] [Qc x; u], W."""
+        c = self.ph
+        _, e, u, _ = self.ph_port(y)
+        return e @ c["R"] @ e + 2.0 * e @ c["P"] @ u + u @ c["S"] @ u
+
     def __call__(self, t, y):
         p, m, Q = y[0:3], y[3:6], y[6:15].reshape(3, 3, order="F")
         mu, x, phth, phx = y[15:18], y[18:21], y[21:24], y[24:27]
@@ -243,6 +282,10 @@ class Field:
             r, _ = self.r_of(t)
             jerk = om ** 3 * (r - f[0]) - (2 * ze + 1) * om ** 2 * f[1] - (2 * ze + 1) * om * f[2]
             n = 45
+        if self.ph is not None:
+            c = self.ph
+            xc, e, u, yc = self.ph_port(y)
+            n = c["at"] + c["n"]
         tau_t = -Q.T @ (K["kp_translational"] @ (x - xr) + K["kd_translational"] @ (Q @ v - vd)
                         + K["ki_translational"] @ phx)
         tau_r = -W.T @ (K["kp_rotational"] @ (th - thr) + K["kd_rotational"] @ (W @ w - thd)
@@ -267,9 +310,14 @@ class Field:
             r, a, k = self.spring
             fs = Q.T @ (-k * (x + Q @ r - a))
             fe, me = fe + fs, me + np.cross(r, fs)
+        if self.ph is not None:
+            tau = -c["B"].T @ yc
+            fe, me = fe + tau[:3], me + tau[3:]
         dy = np.empty(n)
-        if n == 45:
+        if self.sp is not None:
             dy[27:45] = np.concatenate([f[1], f[2], jerk])
+        if self.ph is not None:
+            dy[c["at"]:n] = (c["J"] - c["R"]) @ e + (c["G"] - c["P"]) @ u
         vc = self.vc if self.vc_table is None else np.array(
             [np.interp(t, self.vc_table[0], self.vc_table[1][:, i]) for i in range(3)])
         vr = v - Q.T @ vc
@@ -305,13 +353,20 @@ class Field:
 
     def energy(self, y):
         p, m, mu, x = y[0:3], y[3:6], y[15:18], y[18:21]
-        return 0.5 * m @ (m / self.T) + 0.5 * p @ p / self.mv + 0.5 * mu @ (self.Gp * mu) + 0.5 * self.lam[2] * x[2] ** 2
+        h = 0.5 * m @ (m / self.T) + 0.5 * p @ p / self.mv + 0.5 * mu @ (self.Gp * mu) + 0.5 * self.lam[2] * x[2] ** 2
+        if self.ph is not None:  # the subsystem's storage, 1/2 x^T Qc x
+            xc, e, _, _ = self.ph_port(y)
+            h += 0.5 * xc @ e
+        return h
 
 
 def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | None, t_eval=None,
           rtol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
     """Reference solution on [0, t_end]: DOP853 with rtol 1e-13, split at the controller switch.
-    Returns (t, y) with y of shape (len(t), 27)."""
+    Returns (t, y) with y of shape (len(t), 27), then the set point's filter (18) and the
+    port-Hamiltonian subsystem's states (n) where the vessel has them. ``y0`` is the 27 numbers,
+    or the 27 then the subsystem's states (phsplit's layout of a state that continues a run); the
+    filter starts at rest on the first set point, the subsystem at its ``initial``."""
     segments = []
     cs = control_start if control_start is not None else np.inf
     if cs > 0:
@@ -321,11 +376,18 @@ def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | Non
     t_eval = np.asarray(t_eval) if t_eval is not None else np.array([t_end])
     ts, ys = [], []
     y = np.array(y0, dtype=float)
+    ph = params.get("port_hamiltonian")
+    nc = len(ph["states"]) if ph else 0
+    own = np.array(ph.get("initial", [0.0] * nc), float) if nc else None
+    if nc and len(y) == 27 + nc:
+        y, own = y[:27], y[27:]
     if "setpoint" in params and len(y) == 27:
         # the filter starts at rest on the first set point
         f0 = Field(params, True)
         r0, _ = f0.r_of(params["setpoint"].get("start_time", 0.0))
         y = np.concatenate([y, r0, np.zeros(12)])
+    if nc and len(y) in (27, 45):
+        y = np.concatenate([y, own])
     atol = np.maximum(np.abs(y), 1.0) * rtol * 1e-3
     for a, b, on in segments:
         f = Field(params, on)
