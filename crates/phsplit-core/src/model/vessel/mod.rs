@@ -119,12 +119,45 @@ impl Vessel {
         }
         let initial = Initial::read(&mut p)?;
         let params = p.finish()?;
-        Ok(Self {
+        let v = Self {
             body,
             initial,
             forces,
             params,
-        })
+        };
+        v.check_names()?;
+        Ok(v)
+    }
+
+    /// Every account and every reported quantity has its own name (a subsystem named after
+    /// another component's account or output would hide it in the results).
+    fn check_names(&self) -> Result<()> {
+        use crate::solve::Model;
+        let sys = VesselSystem::new(self, None);
+        let mut seen = std::collections::BTreeMap::new();
+        for a in sys.accounts() {
+            if seen.insert(a.name.to_string(), "account").is_some() {
+                return Err(crate::error::Error::InvalidInput(format!(
+                    "two ledger accounts are named {:?}; a port_hamiltonian.name must differ from the other components' accounts ({})",
+                    a.name,
+                    sys.accounts()
+                        .iter()
+                        .map(|a| a.name)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+        }
+        let mut outs = std::collections::BTreeSet::new();
+        for o in sys.outputs(&self.initial_state(), 0.0) {
+            if !outs.insert(o.name.clone()) {
+                return Err(crate::error::Error::InvalidInput(format!(
+                    "two components report a quantity named {:?}; rename the port-Hamiltonian subsystem (port_hamiltonian.name) or its state (port_hamiltonian.states)",
+                    o.name
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// The same vessel with the components named in `names` built again from `table` (this
