@@ -463,3 +463,30 @@ def test_bad_names_are_refused(change, words):
         phsplit.Vessel.from_dict(d)
     for w in words:
         assert w in str(info.value), (w, str(info.value))
+
+
+def test_a_tuned_tank_splits_the_roll_mode_as_the_two_degree_of_freedom_model_says():
+    """The natural periods of the vessel with a subsystem are those of the coupled system: a
+    U-tube tank (Lloyd's linear model) on the paper's roll splits its 9.2 s mode in two, as the
+    2-DOF Lagrangian model [[I, a], [a, A]] q'' + [[K, c], [c, C]] q = 0 of roll and tank says
+    (written here from Lloyd's coefficients, not from the port-Hamiltonian form)."""
+    d = phsplit.Vessel.paper().to_dict()
+    v0 = d["vessel"]
+    I, m, g, gm = v0["inertia"][0], v0["mass"], v0["gravity"], v0["gm_transverse"]
+    K = m * g * gm
+    A, C = 3.3e7, 1.55e7 * (2 * np.pi / 9.2) ** 2 / (1.55e7 / 3.3e7)  # tuned near the roll period
+    # undamped (tank and hull's roll), where |λ| of each mode is its natural frequency
+    a, c, B = 1.4e7, 1.5e7, 0.0
+    d["vessel"] = {**v0, "inertia": [I - a * a / A, *v0["inertia"][1:]], "gm_transverse": (K - c * c / C) / (m * g),
+                   "damping_rotational": [0.0, *v0["damping_rotational"][1:]]}
+    d["port_hamiltonian"] = {"name": "tank", "states": ["eta", "pi"], "J": [[0.0, 1.0], [-1.0, 0.0]],
+                             "R": [[0.0, 0.0], [0.0, B]], "Q": [[C, 0.0], [0.0, 1.0 / A]],
+                             "G": [[c / C - a / A], [0.0]], "P": [[0.0], [-a * B / A]], "S": [[a * a * B / A / A]],
+                             "input": ["roll"]}
+    got = phsplit.Vessel.from_dict(d).natural_periods(control=False, euler=[0.0, 0.0, 0.0])
+    w2 = np.linalg.eigvals(np.linalg.solve([[I, a], [a, A]], [[K, c], [c, C]])).real
+    want = sorted(2 * np.pi / np.sqrt(w2))
+    alone = phsplit.Vessel.paper().natural_periods(control=False, euler=[0.0, 0.0, 0.0])
+    assert want[0] < 9.2 < want[1]
+    # heave and pitch as without the tank; roll split into the two coupled modes
+    np.testing.assert_allclose(sorted(got), sorted([p for p in alone if p < 5.0] + want), rtol=1e-8)

@@ -23,6 +23,7 @@ use crate::solve::{Account, FieldModel, Model, SplitModel, Work};
 use nalgebra::{Matrix3, SVector, Vector3};
 
 mod memo;
+mod modes;
 mod own;
 mod power;
 mod report;
@@ -295,40 +296,6 @@ impl<'a> VesselSystem<'a> {
         }
         let body = &self.vessel.body;
         b.finish(&body.minv_blocks, body.is_diagonal());
-    }
-
-    /// The natural periods (s) of the oscillating modes of flow S2 linearised at the attitude
-    /// `q`, with the controller `on` or off, ascending: `2π/|λ|` for each eigenvalue pair
-    /// `λ, λ̄` of the two 9×9 block systems (`u' = A_uu u + A_uv v + A_uw w`, `v' = A_vu u`,
-    /// `w' = A_wv v`) with `Im λ ≠ 0`. For a damped oscillator `|λ|` is its undamped natural
-    /// frequency, so the periods do not depend on the damping. Paper vessel, upright, controller
-    /// off: heave `2π √(mv/c)` = 4.25 s, pitch `2π √(T2/(mv g GM_L))` = 4.08 s, roll 9.21 s.
-    /// A step far beyond the shortest of them cannot resolve the motion (docs/model.md §4).
-    pub fn natural_periods(&self, q: &Matrix3<f64>, on: bool) -> Vec<f64> {
-        let b = self.s2_at(q, on, false);
-        // The 18×18 system (the two block systems and what couples them), without the
-        // constant column.
-        let full = s2::augmented(&b);
-        let a: nalgebra::SMatrix<f64, 18, 18> = full.fixed_view::<18, 18>(0, 0).into_owned();
-        let mut out = Vec::new();
-        // Balance by the momentum scale (u = M v): the raw entries span many decades.
-        let scale = a.abs().max().max(f64::MIN_POSITIVE);
-        if let Some(ev) = (a / scale)
-            .try_schur(1e-15, 10_000)
-            .map(|s| s.complex_eigenvalues())
-        {
-            for l in ev.iter() {
-                let (re, im) = (l.re * scale, l.im * scale);
-                let r = re.hypot(im);
-                // A zero mode (surge, sway, yaw without damping) comes out as round-off with a
-                // round-off imaginary part: not an oscillation.
-                if im > 1e-9 * r && r > 1e-12 * scale {
-                    out.push(2.0 * std::f64::consts::PI / r);
-                }
-            }
-        }
-        out.sort_by(|x, y| x.total_cmp(y));
-        out
     }
 
     /// The block states of `s`: translation `(p, x − x_o, phi_x)`, rotation `(m, mu, phi_th)`.

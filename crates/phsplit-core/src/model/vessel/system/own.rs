@@ -264,6 +264,14 @@ impl VesselSystem<'_> {
         sc
     }
 
+    /// The dense matrix of `b` balanced, `S⁻¹ A S`, with the balance `S`.
+    pub(super) fn dense_balanced(&self, b: &S2Builder) -> (DMatrix<f64>, DVector<f64>) {
+        let a = self.dense(b);
+        let sc = self.dense_balance(b, &a);
+        let n = a.nrows();
+        (DMatrix::from_fn(n, n, |i, j| a[(i, j)] * sc[j] / sc[i]), sc)
+    }
+
     /// The exact flow and, with the ledger, each account's energy from the Gramian.
     fn dense_exact(
         &self,

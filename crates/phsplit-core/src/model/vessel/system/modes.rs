@@ -1,0 +1,71 @@
+//! The natural periods of the vessel's linearised flow S2 (docs/model.md §4): the eigenvalues of
+//! the two block systems and what couples them, or of the dense system with the components' own
+//! states.
+
+use super::super::forces::S2Builder;
+use super::s2;
+use super::VesselSystem;
+use nalgebra::Matrix3;
+
+/// The periods `2π/|λ|` of the oscillating eigenvalues of `a` (times `scale`), ascending.
+fn periods_of(ev: impl Iterator<Item = nalgebra::Complex<f64>>, scale: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    for l in ev {
+        let (re, im) = (l.re * scale, l.im * scale);
+        let r = re.hypot(im);
+        // A zero mode (surge, sway, yaw without damping) comes out as round-off with a
+        // round-off imaginary part: not an oscillation.
+        if im > 1e-9 * r && r > 1e-12 * scale {
+            out.push(2.0 * std::f64::consts::PI / r);
+        }
+    }
+    out.sort_by(|x, y| x.total_cmp(y));
+    out
+}
+
+impl VesselSystem<'_> {
+    /// The natural periods (s) of the oscillating modes of flow S2 linearised at the attitude
+    /// `q`, with the controller `on` or off, ascending: `2π/|λ|` for each eigenvalue pair
+    /// `λ, λ̄` of the two 9×9 block systems (`u' = A_uu u + A_uv v + A_uw w`, `v' = A_vu u`,
+    /// `w' = A_wv v`) with `Im λ ≠ 0`. For a damped oscillator `|λ|` is its undamped natural
+    /// frequency, so the periods do not depend on the damping. Paper vessel, upright, controller
+    /// off: heave `2π √(mv/c)` = 4.25 s, pitch `2π √(T2/(mv g GM_L))` = 4.08 s, roll 9.21 s.
+    /// A step far beyond the shortest of them cannot resolve the motion (docs/model.md §4).
+    /// With components that keep states of their own, the modes are those of the coupled system
+    /// (the hull with its subsystems: a tuned tank splits the roll mode in two).
+    pub fn natural_periods(&self, q: &Matrix3<f64>, on: bool) -> Vec<f64> {
+        let b = self.s2_at(q, on, false);
+        if self.own_dim > 0 {
+            return self.natural_periods_own(&b);
+        }
+        // The 18×18 system (the two block systems and what couples them), without the
+        // constant column.
+        let full = s2::augmented(&b);
+        let a: nalgebra::SMatrix<f64, 18, 18> = full.fixed_view::<18, 18>(0, 0).into_owned();
+        // Balance by the momentum scale (u = M v): the raw entries span many decades.
+        let scale = a.abs().max().max(f64::MIN_POSITIVE);
+        match (a / scale)
+            .try_schur(1e-15, 10_000)
+            .map(|s| s.complex_eigenvalues())
+        {
+            Some(ev) => periods_of(ev.iter().cloned(), scale),
+            None => Vec::new(),
+        }
+    }
+
+    /// [`Self::natural_periods`] of the dense system with the components' own states, balanced
+    /// (a similarity: the eigenvalues are the system's).
+    fn natural_periods_own(&self, b: &S2Builder) -> Vec<f64> {
+        let (a, _) = self.dense_balanced(b);
+        let n = a.nrows() - 1;
+        let a = a.view((0, 0), (n, n)).into_owned();
+        let scale = a.amax().max(f64::MIN_POSITIVE);
+        match (a / scale)
+            .try_schur(1e-15, 10_000)
+            .map(|s| s.complex_eigenvalues())
+        {
+            Some(ev) => periods_of(ev.iter().cloned(), scale),
+            None => Vec::new(),
+        }
+    }
+}
