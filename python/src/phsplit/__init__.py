@@ -56,7 +56,7 @@ from .batch import simulate_many, with_parameters
 from .results import open_dataset, open_sweep, rerun
 from .scenario import Scenario
 from .scenario import load as load_scenario
-from .simulate import (Ledger, PassivityWarning, SettingWarning, Settings, Solution, StepSizeWarning, Vessel,
+from .simulate import (Ledger, ModelRangeWarning, PassivityWarning, SettingWarning, Settings, Solution, StepSizeWarning, Vessel,
                        presets, simulate)
 
 
@@ -70,6 +70,7 @@ __all__ = [
     "IntegrationError",
     "InvalidInputError",
     "Ledger",
+    "ModelRangeWarning",
     "PassivityWarning",
     "SettingWarning",
     "PhsplitError",

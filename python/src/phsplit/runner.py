@@ -28,6 +28,35 @@ class PassivityWarning(UserWarning):
     """A composition with negative sub-steps created energy: its discrete map is passive only
     under the condition of the paper's Prop. 2.5, which this run does not meet."""
 
+class ModelRangeWarning(UserWarning):
+    """The motion left the range where the model holds: roll or pitch beyond the small angles
+    of the metacentric restoring (``GM sin θ``, docs/model.md §2.3), which a real hull's
+    righting arm leaves as its deck edge or bilge emerge. The run's numbers are those of the
+    model, not of the hull there."""
+
+
+#: Largest roll and pitch (degrees) the metacentric restoring is taken to hold to. Within the
+#: small angles of initial stability the righting arm is GZ ≈ GM sin φ; beyond them a hull's
+#: GZ curve departs from it (the wall-sided correction, then deck-edge immersion or bilge
+#: emergence), by how much depending on its lines, which phsplit does not have. The limits are
+#: a chosen threshold, stated, not a property of a hull.
+LINEAR_RESTORING_LIMITS = {"roll": 15.0, "pitch": 10.0}
+
+
+def _warn_if_out_of_range(sol, stacklevel: int) -> None:
+    eu = np.asarray(sol.euler)
+    if eu.ndim != 2 or len(eu) == 0:
+        return
+    for k, (name, limit) in enumerate(LINEAR_RESTORING_LIMITS.items()):
+        a = np.degrees(np.abs(eu[:, k]))
+        if np.all(np.isfinite(a)) and a.max() > limit:
+            i = int(np.argmax(a))
+            warnings.warn(ModelRangeWarning(
+                f"{name} reached {a[i]:.0f} degrees (t = {float(sol.t[i]):g} s), beyond the {limit:g} degrees to which the "
+                f"metacentric restoring (GM sin θ) holds: the run follows the model, not the hull's own righting "
+                f"arm there (docs/model.md §2.3)"), stacklevel=stacklevel)
+
+
 def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray, stacklevel: int) -> None:
     """Prop. 2.5: with negative sub-steps the composition dissipates only if
     sum(mu_i c_i) >= 0 over the dissipative flow's coefficients, i.e. if sigma_max/sigma_min of
@@ -128,6 +157,7 @@ def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, ort
     sol.meta["running_max"] = dict(raw["running_max"])
     sol.meta["provenance"] = {"vessel_toml": vessel.to_toml(), "initial_state": sol.state(0),
                               "chunks": [int(used["n_steps"])]}
+    _warn_if_out_of_range(sol, stacklevel)
     return sol
 
 

@@ -15,12 +15,12 @@ import numpy as np
 
 from . import _core, _provided
 from .events import run_with_outputs
-from .runner import PassivityWarning, SettingWarning, StepSizeWarning, run
+from .runner import ModelRangeWarning, PassivityWarning, SettingWarning, StepSizeWarning, run
 from .settings import Settings, settings_to_toml
 from .solution import Ledger, Solution
 from .vessel import Vessel, presets
 
-__all__ = ["simulate", "Vessel", "Solution", "Ledger", "Settings", "presets", "settings_to_toml",
+__all__ = ["simulate", "Vessel", "Solution", "Ledger", "Settings", "presets", "settings_to_toml", "ModelRangeWarning",
            "StepSizeWarning", "PassivityWarning", "SettingWarning"]
 
 
