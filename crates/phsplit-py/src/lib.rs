@@ -5,6 +5,7 @@
 //! and parameter is parsed and validated by the core. Nothing here panics across the
 //! boundary: every fallible call returns `PyResult`, and a panic in the core is caught.
 
+mod capability;
 mod convert;
 mod fmu;
 mod numerics;
@@ -396,6 +397,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     numerics::register(m)?;
     m.add_class::<PyVessel>()?;
     run::register(m)?;
+    capability::register(m)?;
     m.add_function(wrap_pyfunction!(method_info, m)?)?;
     m.add_function(wrap_pyfunction!(fmu::fmu_variables, m)?)?;
     m.add_function(wrap_pyfunction!(euler_zyx, m)?)?;

@@ -53,6 +53,7 @@ from ._core import (
 from ._core import method_info as _method_info
 from . import events, hydro, results, rigid_body, sea, so3, special
 from .batch import simulate_many, with_parameters
+from .capability import capability
 from .results import open_dataset, open_sweep, rerun
 from .scenario import Scenario
 from .scenario import load as load_scenario
@@ -81,6 +82,7 @@ __all__ = [
     "StepSizeWarning",
     "Vessel",
     "__version__",
+    "capability",
     "events",
     "hydro",
     "load_scenario",

@@ -25,6 +25,7 @@ EXAMPLES = """examples:
   phsplit plot out/fig2.nc --watch-circle 5  # the DP figure of a result file
   phsplit fmu export -o vessel.fmu         # an FMI 2.0 co-simulation FMU of the Fig. 2 vessel
   phsplit fmu export pipelay -o pipelay.fmu  # ... of a shipped scenario's vessel and settings
+  phsplit capability dp-capability         # static DP capability (DNV-ST-0111 level 1 style), NetCDF + polar PNG
 """
 
 
@@ -137,6 +138,28 @@ def _parser() -> argparse.ArgumentParser:
         fl.add_argument(f"--{k}", type=float, nargs=3, default=[0.0, 0.0, 0.0], metavar=("X", "Y", "Z"),
                         help=f"{k.replace('-', ' ')}, {unit} (default 0 0 0)")
     fl.add_argument("--period", type=float, default=60.0, help="period, s (default 60)")
+    cp = sub.add_parser(
+        "capability",
+        help="static DP capability: the largest wind speed held per direction, intact and with each thruster lost",
+        description="For each direction of a co-linear level-1 environment (DNV-ST-0111 (2021): wind with its "
+        "sea state and current), the largest wind speed whose mean load the thrusters can balance within their "
+        "limits (the core's allocation), intact and with each single thruster lost. Writes <out>/<name>-capability.nc "
+        "and a polar plot <out>/<name>-capability.png (docs/how-to/dp-capability.md).",
+        epilog="examples:\n  phsplit capability dp-capability\n  phsplit capability my-scenario.toml --step 15 --out cap/\n"
+        "  phsplit capability dp-capability --directions 0 90 180 270 --failures none",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    cp.add_argument("scenario", help="scenario TOML file or shipped scenario name whose vessel has [wind] "
+                    "coefficients and [thrusters] (e.g. dp-capability)")
+    cp.add_argument("--vessel", help="use this vessel (a file or a shipped vessel's name) in the scenario")
+    cp.add_argument("--directions", type=float, nargs="+", metavar="DEG",
+                    help="directions the environment comes from, degrees off the bow, clockwise (default: every --step)")
+    cp.add_argument("--step", type=float, default=10.0, help="spacing of the directions, degrees (default 10)")
+    cp.add_argument("--failures", choices=["single", "none"], default="single",
+                    help="'single': intact and each thruster lost in turn (default); 'none': intact only")
+    cp.add_argument("--tolerance", type=float, default=0.01, help="bisection tolerance in wind speed, m/s (default 0.01)")
+    cp.add_argument("--out", default="out", help="output folder (default: ./out)")
+    cp.add_argument("--no-plot", action="store_true", help="skip the PNG")
     w.add_argument("sweep", help="sweep TOML file ([simulation] + [sweep])")
     w.add_argument("--out", help="result store (a folder; default: <sweep name>.store)")
     w.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://host:8786")
@@ -649,6 +672,66 @@ def _fmu(args) -> int:
     return 0
 
 
+def _capability(args) -> int:
+    from . import scenario as scn
+    from .capability import capability, polar_plot
+
+    if args.directions is None:
+        if not (args.step > 0 and args.step <= 180 and (360.0 / args.step) == round(360.0 / args.step)):
+            raise UsageError(f"--step must divide 360 degrees (e.g. 5, 10, 15), got {args.step:g}")
+        directions = _angles(args.step)
+    else:
+        directions = args.directions
+    import phsplit
+
+    try:
+        sc = scn.load(args.scenario, vessel=args.vessel)
+    except (phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
+        if not args.vessel:
+            raise
+        raise type(e)(f"--vessel {args.vessel} with scenario {args.scenario}: {e}") from None
+    out = args.out
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise UsageError(f"--out {out!r} is a file, not a folder")
+    ds = capability(sc.vessel, directions=directions, failures=args.failures, tolerance=args.tolerance)
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise UsageError(f"output folder {out!r} is not writable")
+    stem = os.path.join(out, f"{sc.name}-capability")
+    nc, png = stem + ".nc", stem + ".png"
+    fd, tmp = tempfile.mkstemp(prefix=".capability-", suffix=".nc", dir=out)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp)
+        os.replace(tmp, nc)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+    u = ds["wind_speed_limit"]
+    print(f"capability of {sc.name}: {ds.sizes['direction']} directions, cases: "
+          f"{', '.join(map(str, ds['case_name'].values))}")
+    print(f"intact: smallest wind speed held {float(u[:, 0].min()):.2f} m/s (Beaufort "
+          f"{int(ds['beaufort_limit'][:, 0].min())})"
+          + (f"; worst single failure: {float(ds['worst_failure_wind_speed'].min()):.2f} m/s (Beaufort "
+             f"{int(ds['worst_failure_beaufort'].min())})" if "worst_failure_wind_speed" in ds else ""))
+    if not ds.attrs["wave_drift_included"]:
+        print("note: the vessel has no wave drift coefficients; the mean wave drift is left out")
+    print(f"wrote {os.path.abspath(nc)}")
+    if not args.no_plot:
+        polar_plot(ds, png, title=f"{sc.name}: wind speed held (m/s)")
+        print(f"wrote {os.path.abspath(png)}")
+    return 0
+
+
+def _angles(step: float) -> list[float]:
+    """0, step, 2 step, ... below 360 degrees."""
+    return [i * step for i in range(int(round(360.0 / step)))]
+
+
 def _methods() -> int:
     import phsplit
 
@@ -713,6 +796,8 @@ def main(argv: list[str] | None = None) -> int:
             return _fmu(args)
         if args.command == "vessels":
             return _vessels()
+        if args.command == "capability":
+            return _capability(args)
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

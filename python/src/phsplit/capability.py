@@ -1,0 +1,455 @@
+"""Static DP capability in the manner of DNV-ST-0111 (December 2021), level 1.
+
+For each direction of a co-linear environment (wind, the sea state that goes with the wind
+speed, and a current), the largest wind speed whose mean load the thrusters can balance within
+their limits, intact and with thrusters lost (docs/how-to/dp-capability.md).
+
+Every load and every limit is the core's: the wind, current and cross-flow loads are the ledger
+accounts' wrenches of the vessel at rest at its heading (``_core.account_wrenches``), the mean
+wave drift is the mean of the core's Newman drift with its drift-coefficient tables
+(``_core.mean_wave_drift``), and the thrusters' answer is the core's allocation
+(``_core.allocate``, ``forces/thrusters.rs``): a demand is held when the allocation needs no
+scaling (``scale == 1``).
+"""
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from .vessel import Vessel
+
+#: The level-1 environment: Beaufort number, wind speed (m/s, 10 m above the sea, the top of
+#: the Beaufort class), significant wave height Hs (m), peak period Tp (s) and current speed
+#: (m/s), as tabulated in DNV-ST-0111 (2021) for level 1; wind, waves and current co-linear.
+LEVEL1 = (
+    (0, 0.0, 0.0, 0.0, 0.0),
+    (1, 1.5, 0.1, 3.5, 0.25),
+    (2, 3.4, 0.4, 4.5, 0.50),
+    (3, 5.4, 0.8, 5.5, 0.75),
+    (4, 7.9, 1.3, 6.5, 0.75),
+    (5, 10.7, 2.1, 7.5, 0.75),
+    (6, 13.8, 3.1, 8.5, 0.75),
+    (7, 17.1, 4.2, 9.0, 0.75),
+    (8, 20.7, 5.7, 10.0, 0.75),
+    (9, 24.4, 7.4, 10.5, 0.75),
+    (10, 28.4, 9.5, 11.5, 0.75),
+    (11, 32.6, 12.1, 12.0, 0.75),
+)
+
+#: The ledger accounts whose wrench at rest is the environment's static load (besides the
+#: mean wave drift): the wind, the current through the linear (and quadratic) damping, and the
+#: current through the cross-flow drag.
+LOAD_ACCOUNTS = ("wind", "current", "crossflow_current")
+
+#: JONSWAP peak enhancement of the sea states.
+GAMMA = 3.3
+
+#: Components of the sea state's mean drift (equal bins in frequency).
+DRIFT_COMPONENTS = 200
+
+
+def _bad(arg: str, msg: str) -> None:
+    raise _core.InvalidInputError(f"capability: {arg}: {msg}")
+
+
+class Environment:
+    """The level-1 environment as a function of the wind speed ``U`` (m/s): Hs, Tp and the
+    current speed interpolated linearly in ``U`` between the rows of ``table`` (rows of
+    Beaufort number, wind speed, Hs, Tp, current speed; default :data:`LEVEL1`)."""
+
+    def __init__(self, table: Sequence[Sequence[float]] = LEVEL1) -> None:
+        try:
+            t = np.asarray(table, dtype=float)
+        except (TypeError, ValueError):
+            _bad("environment", f"must be rows of 5 numbers (Beaufort, wind m/s, Hs m, Tp s, current m/s), got {table!r}")
+        if t.ndim != 2 or t.shape[1] != 5 or t.shape[0] < 2 or not np.all(np.isfinite(t)):
+            _bad("environment", f"must be at least 2 rows of 5 finite numbers (Beaufort, wind m/s, Hs m, Tp s, "
+                 f"current m/s), got shape {t.shape}")
+        if np.any(np.diff(t[:, 1]) <= 0) or t[0, 1] != 0.0:
+            _bad("environment", "the wind speeds must start at 0 and increase row by row")
+        if np.any(t[:, 2:] < 0):
+            _bad("environment", "Hs, Tp and the current speed must be >= 0")
+        self.table = t
+        self.beaufort = t[:, 0].astype(int)
+        self.wind = t[:, 1]
+
+    @property
+    def top(self) -> float:
+        return float(self.wind[-1])
+
+    def at(self, u: float) -> tuple[float, float, float]:
+        """(Hs m, Tp s, current m/s) at wind speed ``u``; a Tp of 0 (calm) takes the next row's."""
+        t = self.table
+        hs = float(np.interp(u, self.wind, t[:, 2]))
+        tp_col = t[:, 3].copy()
+        for i in range(len(tp_col) - 2, -1, -1):
+            if tp_col[i] <= 0:
+                tp_col[i] = tp_col[i + 1]
+        tp = float(np.interp(u, self.wind, tp_col))
+        vc = float(np.interp(u, self.wind, t[:, 4]))
+        return hs, tp, vc
+
+
+def _towards(heading_deg: float, direction_from: float) -> float:
+    """The spatial direction (degrees, x towards y, z up) the environment travels towards, for
+    one coming from ``direction_from`` degrees off the bow, clockwise seen from above (0: from
+    ahead, 90: from starboard)."""
+    return heading_deg + 180.0 - direction_from
+
+
+class _Loads:
+    """The environment's static load (X, Y, N) on the vessel at rest at its heading, from the
+    core."""
+
+    def __init__(self, vessel: Vessel) -> None:
+        tables = vessel.to_dict()
+        self.vessel = vessel
+        if "wind" not in tables:
+            _bad("vessel", "has no [wind] table (its wind coefficients); give a vessel with [wind] "
+                 "(a scenario's [environment.wind], e.g. the shipped dp-capability)")
+        if "thrusters" not in tables:
+            _bad("vessel", "has no [thrusters] table: the capability is that of its thrusters "
+                 "(e.g. the shipped scenario dp-capability)")
+        self.heading = float(tables["initial"]["euler"][2])
+        base = copy.deepcopy(tables)
+        for k in ("waves", "thrusters", "current"):
+            base.pop(k, None)
+        w = base["wind"]
+        for k in ("gust_frequencies", "gust_amplitudes", "gust_phases"):
+            w.pop(k, None)
+        self._base = base
+        self._state = None
+        self._wind: dict[float, np.ndarray] = {}
+        self._current: dict[tuple[float, float], np.ndarray] = {}
+        self._sea: dict[tuple[float, float], tuple] = {}
+        self._total: dict[tuple[float, float], np.ndarray] = {}
+        waves = tables.get("waves", {})
+        self.has_drift = "drift_coefficients" in waves
+        if self.has_drift:
+            f = np.asarray(waves["rao_frequencies"], dtype=float)
+            self.drift_range = (float(f[0]), float(f[-1]))
+        self.accounts_used: set[str] = set()
+
+    def _sum(self, tables: dict) -> np.ndarray:
+        v = _core.Vessel.from_dict(tables)
+        if self._state is None:
+            self._state = np.asarray(v.initial_state(velocity=[0.0, 0.0, 0.0], angular_velocity=[0.0, 0.0, 0.0]))
+        out = np.zeros(3)
+        for name, f, m in _core.account_wrenches(v, self._state, 0.0):
+            if name in LOAD_ACCOUNTS:
+                out += (f[0], f[1], m[2])
+                if any(abs(x) > 0 for x in (f[0], f[1], m[2])):
+                    self.accounts_used.add(name)
+        return out
+
+    def wind_unit(self, towards: float) -> np.ndarray:
+        """The core's wind load at 1 m/s towards ``towards`` (degrees); at rest it scales with
+        the square of the speed (``q = ½ ρ U²``, ``forces/wind.rs``)."""
+        key = round(towards % 360.0, 9)
+        if key not in self._wind:
+            t = copy.deepcopy(self._base)
+            t["wind"].update(speed=1.0, direction=towards)
+            self._wind[key] = self._sum(t)
+        return self._wind[key]
+
+    def wind(self, u: float, towards: float) -> np.ndarray:
+        return u * u * self.wind_unit(towards)
+
+    def wind_direct(self, u: float, towards: float) -> np.ndarray:
+        """The core's wind load at speed ``u`` itself (a check of the scaling)."""
+        t = copy.deepcopy(self._base)
+        t["wind"].update(speed=float(u), direction=towards)
+        return self._sum(t)
+
+    def current(self, vc: float, towards: float) -> np.ndarray:
+        """The core's current load (damping and cross-flow drag on the relative velocity) at
+        speed ``vc`` towards ``towards``."""
+        key = (round(vc, 12), round(towards % 360.0, 9))
+        if key not in self._current:
+            if vc == 0.0:
+                self._current[key] = np.zeros(3)
+            else:
+                t = copy.deepcopy(self._base)
+                t["wind"]["speed"] = 0.0
+                a = math.radians(towards)
+                t["current"] = {"velocity": [vc * math.cos(a), vc * math.sin(a), 0.0]}
+                self._current[key] = self._sum(t)
+        return self._current[key]
+
+    def sea(self, hs: float, tp: float) -> tuple[np.ndarray, np.ndarray, float]:
+        """Components (ω, a) of the JONSWAP sea state on the drift table's frequencies (equal
+        bins, at their centres), and the fraction of the spectrum's variance they hold. The
+        spectrum is wavespectra's JONSWAP (as phsplit.sea's), scaled to ``4 √m0 = Hs`` over
+        phsplit.sea's default range ``[0.5, 3] ω_p``: the part outside the drift data is left
+        out, not folded into the rest."""
+        key = (hs, tp)
+        if key in self._sea:
+            return self._sea[key]
+        from wavespectra.construct.frequency import jonswap
+
+        from .sea import SeaState
+
+        s = SeaState(hs=hs, tp=tp, gamma=GAMMA)
+        lo_s, hi_s = s.range()
+        lo, hi = max(lo_s, self.drift_range[0]), min(hi_s, self.drift_range[1])
+        if not hi > lo:
+            out = (np.zeros(0), np.zeros(0), 0.0)
+        else:
+            n = DRIFT_COMPONENTS
+            dw = (hi - lo) / n
+            om = lo + (np.arange(n) + 0.5) * dw
+            grid = np.linspace(lo_s, hi_s, 4001) / (2 * np.pi)  # Hz, as SeaState.density
+            both = np.asarray(jonswap(np.concatenate([grid, om / (2 * np.pi)]), fp=1.0 / tp, gamma=GAMMA))
+            m0 = np.trapezoid(both[:grid.size], grid)
+            dens = both[grid.size:] * (hs / 4.0) ** 2 / m0 / (2 * np.pi)
+            amp = np.sqrt(2.0 * dens * dw)
+            out = (om, amp, float(np.sum(dens) * dw / (hs / 4.0) ** 2))
+        if len(self._sea) > 4096:
+            self._sea.clear()
+        self._sea[key] = out
+        return out
+
+    def drift(self, hs: float, tp: float, towards: float) -> tuple[np.ndarray, float]:
+        """The mean of the core's wave drift in the sea state (Hs, Tp) travelling towards
+        ``towards``; zero without drift data or for a sea state below 1 mm."""
+        if not self.has_drift or hs < 1e-3:
+            return np.zeros(3), 1.0 if hs < 1e-3 else 0.0
+        om, amp, covered = self.sea(hs, tp)
+        if len(om) == 0:
+            return np.zeros(3), 0.0
+        d = _core.mean_wave_drift(self.vessel._inner, self.heading, om.tolist(), amp.tolist(),
+                                  [towards] * len(om))
+        return np.asarray(d), covered
+
+    def total(self, env: Environment, u: float, towards: float) -> np.ndarray:
+        """The whole static load (X, Y, N) at wind speed ``u`` towards ``towards``."""
+        key = (u, towards)
+        if key not in self._total:
+            hs, tp, vc = env.at(u)
+            if len(self._total) > 65536:
+                self._total.clear()
+            self._total[key] = self.wind(u, towards) + self.current(vc, towards) + self.drift(hs, tp, towards)[0]
+        return self._total[key]
+
+
+def _cases(failures: Any, n: int) -> list[tuple[str, list[int]]]:
+    if failures is None or (isinstance(failures, str) and failures == "none"):
+        return [("intact", [])]
+    if isinstance(failures, str):
+        if failures != "single":
+            _bad("failures", f"must be 'single' (each thruster lost in turn), 'none', or a list of lists of "
+                 f"thruster indices, got {failures!r}")
+        return [("intact", [])] + [(f"thruster {i} lost", [i]) for i in range(n)]
+    try:
+        groups = [list(g) for g in failures]
+    except TypeError:
+        _bad("failures", f"must be 'single', 'none', or a list of lists of thruster indices, got {failures!r}")
+    out = [("intact", [])]
+    for g in groups:
+        if not g or not all(isinstance(i, (int, np.integer)) and not isinstance(i, bool) for i in g):
+            _bad("failures", f"each failure is a non-empty list of thruster indices (integers), got {g!r}")
+        bad = [int(i) for i in g if not 0 <= int(i) < n]
+        if bad:
+            _bad("failures", f"thruster index {bad[0]} does not exist (the vessel has {n} thrusters, 0..{n - 1})")
+        g = sorted({int(i) for i in g})
+        out.append(("thrusters " + ", ".join(map(str, g)) + " lost" if len(g) > 1 else f"thruster {g[0]} lost", g))
+    return out
+
+
+def _directions(directions: Any) -> np.ndarray:
+    if directions is None:
+        return np.arange(0.0, 360.0, 10.0)
+    try:
+        d = np.asarray(directions, dtype=float)
+    except (TypeError, ValueError):
+        _bad("directions", f"must be numbers (degrees), got {directions!r}")
+    d = np.atleast_1d(d)
+    if d.ndim != 1 or d.size == 0 or not np.all(np.isfinite(d)):
+        _bad("directions", f"must be a non-empty list of finite numbers (degrees), got {directions!r}")
+    if np.any((d < 0) | (d >= 360)):
+        _bad("directions", "must lie in [0, 360) degrees (where the environment comes from, off the bow, clockwise)")
+    if len(np.unique(d)) != len(d):
+        _bad("directions", "must not repeat a direction")
+    return d
+
+
+def held(vessel: Vessel, demand: Sequence[float], lost: Sequence[int] = ()) -> dict:
+    """The core's allocation of a demand (X, Y, N) on the vessel's thrusters without ``lost``:
+    ``scale`` (1 when held), ``utilisation``, ``thrust``, ``angle``."""
+    return _core.allocate(vessel._inner, [float(x) for x in demand], [int(i) for i in lost])
+
+
+def _feasible(vessel: Vessel, load: np.ndarray, lost: list[int]) -> bool:
+    return held(vessel, -load, lost)["scale"] >= 1.0 - 1e-12
+
+
+def capability(vessel: Any, directions: Any = None, failures: Any = "single",
+               environment: Sequence[Sequence[float]] = LEVEL1, tolerance: float = 0.01):
+    """The static DP capability of ``vessel`` (a :class:`phsplit.Vessel` with ``[wind]`` and
+    ``[thrusters]``, a :class:`phsplit.scenario.Scenario`, or a scenario file or shipped scenario
+    name) in the level-1 environment of DNV-ST-0111 (2021).
+
+    ``directions``: degrees the environment comes from, off the bow, clockwise seen from above
+    (0 from ahead, 90 from starboard; default every 10°). ``failures``: ``"single"`` (intact and
+    each thruster lost in turn; the default), ``"none"`` (intact only), or a list of lists of
+    thruster indices. ``environment``: rows of (Beaufort, wind m/s, Hs m, Tp s, current m/s)
+    (default :data:`LEVEL1`). ``tolerance``: of the bisection in wind speed, m/s.
+
+    Returns an xarray Dataset over (direction, case): ``wind_speed_limit`` (m/s, the largest wind
+    speed held, with its sea state and current), ``beaufort_limit`` (the largest Beaufort number
+    whose row, and every row below it, is held), ``at_table_top`` (held at the table's last
+    row: the limit is at least that), ``hs_limit``, ``tp_limit``, ``current_limit``, and
+    ``utilisation_at_limit``; ``worst_failure_wind_speed`` (direction) over the failure cases.
+    """
+    import xarray as xr
+
+    from . import cf
+    from .scenario import Scenario, load
+
+    if isinstance(vessel, (str,)) or hasattr(vessel, "__fspath__"):
+        vessel = load(vessel).vessel
+    elif isinstance(vessel, Scenario):
+        vessel = vessel.vessel
+    if not isinstance(vessel, Vessel):
+        _bad("vessel", f"must be a phsplit.Vessel, a Scenario, or a scenario file or name, got {type(vessel).__name__}")
+    if not (isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool)
+            and math.isfinite(tolerance) and 1e-9 <= tolerance <= 1.0):
+        _bad("tolerance", f"must be a number in [1e-9, 1] (m/s), got {tolerance!r}")
+    dirs = _directions(directions)
+    env = Environment(environment)
+    loads = _Loads(vessel)
+    units = _core.thruster_units(vessel._inner)
+    cases = _cases(failures, len(units))
+    heading_deg = math.degrees(loads.heading)
+
+    shape = (len(dirs), len(cases))
+    u_lim = np.zeros(shape)
+    bf_lim = np.zeros(shape, dtype=np.int32)
+    top = np.zeros(shape, dtype=bool)
+    util = np.full(shape, np.nan)
+    rank_ok = np.ones(len(cases), dtype=bool)
+    covered = np.ones(shape)
+    for j, (_, lost) in enumerate(cases):
+        try:
+            held(vessel, [0.0, 0.0, 0.0], lost)
+        except _core.InvalidInputError:
+            rank_ok[j] = False  # the rest cannot produce surge, sway and yaw: nothing is held
+    for i, d in enumerate(dirs):
+        towards = _towards(heading_deg, float(d))
+        for j, (_, lost) in enumerate(cases):
+            if not rank_ok[j]:
+                continue
+            ok = lambda u: _feasible(vessel, loads.total(env, u, towards), lost)  # noqa: E731
+            # the Beaufort number: every row up to it held
+            n = 0
+            for k in range(1, len(env.wind)):
+                if not ok(float(env.wind[k])):
+                    break
+                n = k
+            bf_lim[i, j] = env.beaufort[n]
+            if n == len(env.wind) - 1:
+                u_lim[i, j], top[i, j] = env.top, True
+            else:
+                lo, hi = float(env.wind[n]), float(env.wind[n + 1])
+                while hi - lo > tolerance:
+                    mid = 0.5 * (lo + hi)
+                    if ok(mid):
+                        lo = mid
+                    else:
+                        hi = mid
+                u_lim[i, j] = lo
+            hs, tp, _ = env.at(u_lim[i, j])
+            util[i, j] = held(vessel, -loads.total(env, u_lim[i, j], towards), lost)["utilisation"]
+            covered[i, j] = loads.drift(hs, tp, towards)[1]
+    hs_l, tp_l, vc_l = (np.vectorize(lambda u, k=k: env.at(u)[k])(u_lim) for k in range(3))
+    names = [c[0] for c in cases]
+    ds = xr.Dataset(
+        {
+            "wind_speed_limit": (("direction", "case"), u_lim, {
+                "units": "m s-1", "standard_name": "wind_speed",
+                "long_name": "largest wind speed held (10 m, level-1 environment)"}),
+            "beaufort_limit": (("direction", "case"), bf_lim, {
+                "units": "1", "long_name": "DP capability number: largest Beaufort number held, with every one below it"}),
+            "at_table_top": (("direction", "case"), top, {
+                "long_name": "held at the environment table's last row (the limit is at least that)"}),
+            "hs_limit": (("direction", "case"), hs_l, {
+                "units": "m", "standard_name": "sea_surface_wave_significant_height",
+                "long_name": "significant wave height at the limit"}),
+            "tp_limit": (("direction", "case"), tp_l, {
+                "units": "s", "long_name": "peak period at the limit"}),
+            "current_limit": (("direction", "case"), vc_l, {
+                "units": "m s-1", "long_name": "current speed at the limit"}),
+            "utilisation_at_limit": (("direction", "case"), util, {
+                "units": "1", "long_name": "largest thrust over its limit at the limit (core allocation)"}),
+            "drift_variance_covered": (("direction", "case"), covered, {
+                "units": "1", "long_name": "fraction of the sea state's variance inside the drift data's frequencies"}),
+            "case_rank_ok": (("case",), rank_ok, {
+                "long_name": "the remaining thrusters can produce surge, sway and yaw (else nothing is held)"}),
+        },
+        coords={
+            "direction": ("direction", dirs, {
+                "units": "degree",
+                "long_name": "direction the wind, waves and current come from, off the bow, clockwise seen from above"}),
+            "case": ("case", names),
+        },
+    )
+    failed = [j for j, c in enumerate(cases) if c[1]]
+    if failed:
+        worst = u_lim[:, failed].min(axis=1)
+        ds["worst_failure_wind_speed"] = (("direction",), worst, {
+            "units": "m s-1", "standard_name": "wind_speed",
+            "long_name": "largest wind speed held with the worst of the failure cases"})
+        ds["worst_failure_beaufort"] = (("direction",), bf_lim[:, failed].min(axis=1).astype(np.int32), {
+            "units": "1", "long_name": "DP capability number with the worst of the failure cases"})
+    ds.attrs.update({
+        "method": "static balance of the mean environmental load and the thrusters' allocation (DNV-ST-0111 "
+                  "(2021) level 1 style): bisection in wind speed on the core's allocation needing no scaling",
+        "environment_table": "; ".join(f"BF{int(r[0])}: {r[1]:g} m/s, Hs {r[2]:g} m, Tp {r[3]:g} s, current "
+                                       f"{r[4]:g} m/s" for r in env.table),
+        "loads": "wind (the vessel's [wind] coefficients), current (damping and cross-flow drag on the relative "
+                 "velocity), mean wave drift: the core's, on the vessel at rest at its heading"
+                 + ("" if loads.has_drift else "; the mean wave drift is LEFT OUT: the vessel has no drift coefficients"),
+        "wave_drift_included": int(loads.has_drift),
+        "load_accounts": ", ".join(sorted(loads.accounts_used)) or "none",
+        "heading_deg": heading_deg,
+        "thrusters": "; ".join(f"{k}: {kind} at ({x:g}, {y:g}) m, {mx:g} N" for k, (kind, x, y, _z, mx, _mn) in enumerate(units)),
+        "wave_spectrum": f"JONSWAP, gamma {GAMMA}, long-crested, co-linear with the wind",
+        "tolerance_m_s": float(tolerance),
+        "vessel_source": vessel.source,
+        "not_modelled": "thrust losses, thruster interaction, forbidden zones, dynamic allowance, power limits",
+    })
+    return cf.finish(ds, "phsplit DP capability (static, level 1)", "phsplit.capability")
+
+
+def polar_plot(ds, path: str, title: str | None = None) -> None:
+    """Draw a capability dataset's wind speed limits as a polar plot (0 from ahead, clockwise)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    th = np.radians(np.append(ds["direction"].values, ds["direction"].values[0]))
+    fig = plt.figure(figsize=(6.5, 6.5))
+    ax = fig.add_subplot(projection="polar")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    labels = ds["case_name"].values if "case_name" in ds.coords else ds["case"].values
+    for j, name in enumerate(labels):
+        u = ds["wind_speed_limit"].values[:, j]
+        ax.plot(th, np.append(u, u[0]), lw=2.0 if j == 0 else 1.0, ls="-" if j == 0 else "--", label=str(name))
+    top = ds["wind_speed_limit"].values[ds["at_table_top"].values.astype(bool)]
+    if top.size:
+        ring = np.linspace(0.0, 2 * np.pi, 361)
+        ax.plot(ring, np.full(ring.size, top.max()), color="0.5", lw=0.8, ls=":", label="top of the table")
+    ax.set_rlim(0.0, 1.05 * float(np.nanmax(ds["wind_speed_limit"].values)) or 1.0)
+    ax.set_rlabel_position(135)
+    ax.set_title(title or "DP capability: wind speed held (m/s)", pad=20)
+    ax.legend(loc="lower left", bbox_to_anchor=(-0.12, -0.16), fontsize=8, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
