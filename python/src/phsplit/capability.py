@@ -25,7 +25,8 @@ from .vessel import Vessel
 
 #: The level-1 environment: Beaufort number, wind speed (m/s, 10 m above the sea, the top of
 #: the Beaufort class), significant wave height Hs (m), peak period Tp (s) and current speed
-#: (m/s), as tabulated in DNV-ST-0111 (2021) for level 1; wind, waves and current co-linear.
+#: (m/s), the level-1 table of DNV-ST-0111 (2021) as it is usually restated (not checked against
+#: the standard's text here: pass your own as `environment`); wind, waves and current co-linear.
 LEVEL1 = (
     (0, 0.0, 0.0, 0.0, 0.0),
     (1, 1.5, 0.1, 3.5, 0.25),
