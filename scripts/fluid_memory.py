@@ -21,7 +21,6 @@ import sys
 import time
 
 import numpy as np
-
 import phsplit
 from phsplit import hydro, radiation, sea
 

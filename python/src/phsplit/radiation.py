@@ -79,8 +79,8 @@ class FluidMemory:
     the 6×6 ``A∞`` (about the body origin) the vessel takes as ``added_mass``; ``blocks``: per DOF
     group, its blocks ``(kind, parameters)``; ``block_list`` and ``S``: one entry per column of
     the ``L_k`` kept, its block and its rank-one ``l lᵀ`` (6×6), so that ``K(s) = Σ h(s) S``; ``report``: per coupling kept, the relative fit errors (``max``: the
-    largest ``|K_fit − K|`` over the dataset's frequencies divided by the largest ``|K|``; ``rms``:
-    the same in the root mean square), and ``dropped``: the couplings left out with their size
+    largest ``|K_fit − K|`` over the dataset's frequencies divided by the largest ``|K|``; ``at``: the
+    frequency of that largest error; ``rms``: the same in the root mean square), and ``dropped``: the couplings left out with their size
     relative to the diagonal; ``omega``, ``K``: the dataset's frequencies and its ``K(iω)``;
     ``a_inf_source``: where ``A∞`` came from."""
 
@@ -106,10 +106,10 @@ class FluidMemory:
 
     def report_table(self) -> str:
         """The fit report as a Markdown table (couplings kept, relative errors)."""
-        rows = ["| coupling | max \\|K\\| (kg/s or kg m/s, kg m²/s) | max rel. error | RMS rel. error |",
-                "|---|---|---|---|"]
+        rows = ["| coupling | max \\|K\\| (kg/s or kg m/s, kg m²/s) | max rel. error | at ω (rad/s) | RMS rel. error |",
+                "|---|---|---|---|---|"]
         for name, r in self.report.items():
-            rows.append(f"| {name} | {r['scale']:.3g} | {r['max']:.3f} | {r['rms']:.3f} |")
+            rows.append(f"| {name} | {r['scale']:.3g} | {r['max']:.3f} | {r['at']:.2f} | {r['rms']:.3f} |")
         return "\n".join(rows)
 
 
@@ -168,12 +168,12 @@ def transfer(blocks, S, omega) -> np.ndarray:
 
 def retardation_data(dataset, *, symmetric: bool = True, checks: str = "refuse", vessel=None,
                      a_inf: str = "dataset"):
-    """The dataset's frequencies, ``K(iω) = B(ω) + iω(A(ω) − A∞)`` about the body origin, ``A∞``
-    and where it came from. ``a_inf``: ``"dataset"`` (Capytaine's ``added_mass_infinite_frequency``;
+    """``(ω, K, A∞, source, loaded)``: the dataset's frequencies, ``K(iω) = B(ω) + iω(A(ω) − A∞)``
+    about the body origin (its symmetric part), ``A∞``, where it came from, and what
+    :func:`phsplit.hydro.from_capytaine` gave. ``a_inf``: ``"dataset"`` (Capytaine's ``added_mass_infinite_frequency``;
     the highest frequency's ``A`` if the dataset lacks it) or ``"highest"`` (the highest
     frequency's ``A``)."""
     from . import hydro
-    import xarray as xr
 
     out = hydro.from_capytaine(dataset, symmetric=symmetric, checks=checks, vessel=vessel)
     raw = hydro._open(dataset)
@@ -399,7 +399,7 @@ def fluid_memory(dataset, *, symmetric: bool = True, checks: str = "refuse", ves
     Refused (``InvalidInputError``, naming the coupling): a retardation that is not finite, a DOF
     whose retardation is zero (nothing to fit), a diagonal whose damping is negative at a
     frequency (a memory that would supply energy)."""
-    w, K, Ainf, src, out = retardation_data(dataset, symmetric=symmetric, checks=checks, vessel=vessel, a_inf=a_inf)
+    w, K, Ainf, src, _ = retardation_data(dataset, symmetric=symmetric, checks=checks, vessel=vessel, a_inf=a_inf)
     if not np.all(np.isfinite(K)):
         _, a, b = np.argwhere(~np.isfinite(K))[0]
         raise _err(f"the retardation K(iw) = B + iw(A - A_inf) of {coupling_name(a, b)} is not finite")
@@ -461,7 +461,7 @@ def fluid_memory(dataset, *, symmetric: bool = True, checks: str = "refuse", ves
     for nm in list(report):
         a, b = (DOFS.index(x) for x in nm.split("-"))
         e = np.abs(F[:, a, b] - K[:, a, b]) / report[nm]["scale"]
-        report[nm].update(max=float(e.max()), rms=float(np.sqrt(np.mean(e ** 2))))
+        report[nm].update(max=float(e.max()), rms=float(np.sqrt(np.mean(e ** 2))), at=float(w[int(np.argmax(e))]))
     return fm
 
 
