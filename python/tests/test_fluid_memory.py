@@ -6,6 +6,7 @@ table's matrices, G^T Q (sI - (J - R)Q)^-1 G; the frequency-domain RAO
 vessel (Fossen 2021, ch. 5)."""
 from __future__ import annotations
 
+import copy
 import math
 import os
 import warnings
@@ -202,3 +203,32 @@ def test_a_vessel_with_a_subsystem_already_is_refused():
                              "R": [[0.0, 0.0], [0.0, 1.0]], "Q": [[1.0, 0.0], [0.0, 1.0]], "G": [[0.0], [1.0]]}
     with pytest.raises(phsplit.InvalidInputError, match="already has a port-Hamiltonian subsystem"):
         radiation.with_fluid_memory(phsplit.Vessel.from_dict(d), DATASET)
+
+
+def test_the_scenario_key_switches_it_on_and_a_second_subsystem_is_refused(memory):
+    """``fluid_memory = true`` in dp-weather's [environment.waves]: the vessel gets the subsystem
+    and A_inf (the same fit as Python's, the origin at the dataset's centre of mass, which is the
+    paper vessel's), and a short run's ledger closes; with the anti-roll tank it is refused."""
+    from phsplit import scenario
+
+    _, fm = memory
+    data = scenario._read_toml(scenario.resolve("dp-weather"), "scenario file")
+    data["environment"]["waves"]["fluid_memory"] = True
+    data["simulation"]["t_span"] = [0.0, 20.0]
+    sc = scenario.from_dict(data, scenario.resolve("dp-weather"))
+    d = sc.vessel.to_dict()
+    assert d["port_hamiltonian"]["states"] == fm.table["states"]
+    np.testing.assert_allclose(np.array(d["port_hamiltonian"]["G"]), np.array(fm.table["G"]), rtol=1e-12, atol=0)
+    np.testing.assert_allclose(np.array(d["vessel"]["added_mass"]), fm.added_mass_infinite, rtol=1e-12, atol=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", phsplit.SettingWarning)
+        s = phsplit.simulate(sc.vessel, settings=sc.settings)
+    assert s.status == "completed" and s.ledger.relative_residual().max() < 1e-10
+    tank = scenario._read_toml(scenario.resolve("anti-roll-tank"), "scenario file")
+    tank["environment"]["waves"]["fluid_memory"] = True
+    with pytest.raises(phsplit.InvalidInputError, match="already has a port-Hamiltonian subsystem"):
+        scenario.from_dict(tank, scenario.resolve("anti-roll-tank"))
+    bad = copy.deepcopy(data)
+    bad["environment"]["waves"]["fluid_memory"] = "yes"
+    with pytest.raises(phsplit.ScenarioParseError, match="fluid_memory must be true or false"):
+        scenario.from_dict(bad, scenario.resolve("dp-weather"))
