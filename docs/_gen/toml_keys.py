@@ -179,6 +179,8 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "symmetric": ("-", "false", "mirror 0–180 degrees for a port–starboard symmetric hull; without it, waves "
                       "from a direction the dataset does not cover are refused"),
         "hydro_checks": ("-", '"refuse"', '`"refuse"` a dataset that fails a physics check, or `"warn"` and use it'),
+        "fluid_memory": ("-", "false", "add the dataset's Cummins fluid memory: the subsystem `radiation` and "
+                         "`A∞` as `vessel.added_mass` (needs `hydro`; Example: Cummins' fluid memory)"),
     },
     "environment.wind": {
         "speed": ("m/s", REQ, "mean speed at 10 m"),

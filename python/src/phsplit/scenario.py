@@ -181,7 +181,11 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
         if isinstance(over.get(table), Mapping):
             over[table] = in_radians(dict(over[table]), table, key, path)
     if "environment" in data:
-        over = overlay(over, _environment(data["environment"], path, base_dir))
+        env_tables = _environment(data["environment"], path, base_dir)
+        if "port_hamiltonian" in env_tables and ("port_hamiltonian" in over or "port_hamiltonian" in base.to_dict()):
+            raise _core.InvalidInputError(f"{path}: environment.waves.fluid_memory: the vessel already has a "
+                                          f"port-Hamiltonian subsystem, and a vessel holds one")
+        over = overlay(over, env_tables)
     if over:
         try:
             vessel = Vessel.from_dict(overlay(base.to_dict(), over), f"{source} with the tables of {path}")
@@ -254,7 +258,9 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
     dataset (``hydro = "file.nc"``, relative to the scenario; ``symmetric = true`` mirrors a
     port–starboard symmetric hull's directions; ``hydro_checks = "warn"`` uses a dataset that fails
     a physics check with a warning instead of refusing it, docs/hydrodynamic-data.md) or from the
-    vessel file's own ``[waves]`` keys."""
+    vessel file's own ``[waves]`` keys; ``fluid_memory = true`` adds the dataset's Cummins fluid
+    memory (``phsplit.radiation``: the ``[port_hamiltonian]`` table ``radiation`` and ``A∞`` as
+    ``vessel.added_mass``; docs/explanation/components/fluid-memory.md)."""
     if not isinstance(env, Mapping):
         raise _core.ScenarioParseError(f"{path}: [environment] must be a table")
     allowed = ("current", "waves", "wind")
@@ -302,6 +308,21 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
                     "are not extrapolated across the gap: use a dataset with that direction, change "
                     "environment.waves.direction (or its spreading)"
                     + ("" if sym else ", or symmetric = true for a port-starboard symmetric hull"))
+        memory = w.get("fluid_memory", False)
+        if not isinstance(memory, bool):
+            raise _core.ScenarioParseError(f"{path}: environment.waves.fluid_memory must be true or false, got {memory!r}")
+        if memory:
+            if "hydro" not in w:
+                raise _core.ScenarioParseError(f"{path}: environment.waves.fluid_memory needs environment.waves.hydro "
+                                               f"(the Capytaine dataset whose added mass and damping it fits)")
+            from . import radiation
+
+            try:
+                fm = radiation.fluid_memory(p, symmetric=sym, checks=checks)
+            except _core.InvalidInputError as e:
+                raise _core.InvalidInputError(f"{path}: environment.waves.fluid_memory: {e}") from None
+            out["port_hamiltonian"] = fm.table
+            out["vessel"] = {"added_mass": fm.added_mass_infinite.tolist()}
         out["waves"] = {**table, **comps}
     if "wind" in env:
         try:

@@ -205,14 +205,14 @@ def sea_state(table: dict) -> SeaState:
     allowed = {"hs", "tp", "gamma", "spectrum", "direction", "spreading", "seed", "components", "omega_range"}
     table = _with_direction(table, "environment.waves")
     allowed_shown = allowed | set(DIRECTION_KEYS)
-    unknown = sorted(set(table) - allowed - {"hydro", "symmetric", "hydro_checks"})
+    unknown = sorted(set(table) - allowed - {"hydro", "symmetric", "hydro_checks", "fluid_memory"})
     if unknown:
         import difflib
 
         near = difflib.get_close_matches(unknown[0], sorted(allowed_shown), n=1)
         hint = f"; did you mean {near[0]!r}?" if near else ""
         raise _core.ScenarioParseError(f"unknown field {unknown[0]!r} in [environment.waves]{hint} "
-                                       f"(allowed: {', '.join(sorted(allowed_shown | {'hydro', 'symmetric', 'hydro_checks'}))})")
+                                       f"(allowed: {', '.join(sorted(allowed_shown | {'hydro', 'symmetric', 'hydro_checks', 'fluid_memory'}))})")
     for k in ("hs", "tp"):
         if k not in table:
             raise _core.ScenarioParseError(f"missing field {k!r} in [environment.waves] "
