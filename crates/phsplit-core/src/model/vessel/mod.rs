@@ -135,25 +135,35 @@ impl Vessel {
         use crate::solve::Model;
         let sys = VesselSystem::new(self, None);
         let mut seen = std::collections::BTreeMap::new();
-        for a in sys.accounts() {
-            if seen.insert(a.name.to_string(), "account").is_some() {
-                return Err(crate::error::Error::InvalidInput(format!(
-                    "two ledger accounts are named {:?}; a port_hamiltonian.name must differ from the other components' accounts ({})",
-                    a.name,
-                    sys.accounts()
-                        .iter()
-                        .map(|a| a.name)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )));
+        for f in &self.forces {
+            for a in f.accounts() {
+                if let Some(first) = seen.insert(a.name, f.name()) {
+                    return Err(crate::error::Error::InvalidInput(format!(
+                        "two ledger accounts are named {:?} (of {first} and {}): rename the latter ({}.name); the accounts are {}",
+                        a.name,
+                        f.name(),
+                        f.name(),
+                        sys.accounts()
+                            .iter()
+                            .map(|a| a.name)
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )));
+                }
             }
         }
+        let named: Vec<&str> = self.own_layout().map(|(f, _)| f.name()).collect();
         let mut outs = std::collections::BTreeSet::new();
         for o in sys.outputs(&self.initial_state(), 0.0) {
             if !outs.insert(o.name.clone()) {
+                let keys: Vec<String> = named
+                    .iter()
+                    .map(|n| format!("{n}.name or {n}.states"))
+                    .collect();
                 return Err(crate::error::Error::InvalidInput(format!(
-                    "two components report a quantity named {:?}; rename the port-Hamiltonian subsystem (port_hamiltonian.name) or its state (port_hamiltonian.states)",
-                    o.name
+                    "two components report a quantity named {:?}: rename a subsystem or its state ({})",
+                    o.name,
+                    keys.join("; ")
                 )));
             }
         }
