@@ -490,3 +490,31 @@ def test_a_tuned_tank_splits_the_roll_mode_as_the_two_degree_of_freedom_model_sa
     assert want[0] < 9.2 < want[1]
     # heave and pitch as without the tank; roll split into the two coupled modes
     np.testing.assert_allclose(sorted(got), sorted([p for p in alone if p < 5.0] + want), rtol=1e-8)
+
+
+def test_the_fmu_of_a_vessel_with_a_subsystem_validates_and_steps(tmp_path):
+    """The FMU of the shipped anti-roll tank: valid for FMPy, every output of the subsystem a
+    variable (units the exporter has not seen before, 'W' and 'kg m2 s-1', declared with their
+    SI base units), and a short co-simulation with the tank's account booked."""
+    fmpy = pytest.importorskip("fmpy")
+    from fmpy.validation import validate_fmu
+
+    from phsplit import fmu, scenario
+
+    p = fmu.export(scenario.load("anti-roll-tank"), tmp_path / "tank.fmu")
+    assert validate_fmu(str(p)) == []
+    md = fmpy.read_model_description(str(p))
+    names = {v.name for v in md.modelVariables}
+    assert {"tank_eta", "tank_pi", "tank_storage", "tank_power", "ledger.tank", "force_tank.y"} <= names
+    units = {u.name: u.baseUnit for u in md.unitDefinitions}
+    assert units["W"].kg == 1 and units["W"].m == 2 and units["W"].s == -3
+    r = fmpy.simulate_fmu(str(p), stop_time=10.0, output_interval=5.0, output=["tank_storage", "ledger.tank"])
+    assert np.all(np.isfinite(r["tank_storage"])) and r["ledger.tank"][-1] > 0.0
+
+
+def test_export_refuses_a_vessel_where_a_scenario_goes(tmp_path):
+    from phsplit import fmu
+
+    with pytest.raises(phsplit.InvalidInputError, match="Scenario"):
+        fmu.export(phsplit.Vessel.paper(), tmp_path / "x.fmu")
+    assert not (tmp_path / "x.fmu").exists()

@@ -46,6 +46,36 @@ _UNITS = {
 }
 
 
+#: SI symbols as base-unit exponents, for units written as products of powers (CF/UDUNITS style:
+#: ``kg m2 s-1``, ``N.m``, ``m/s``), the form components and subsystems give their outputs in.
+_SYMBOLS = {"m": {"m": 1}, "kg": {"kg": 1}, "s": {"s": 1}, "rad": {"rad": 1}, "K": {"K": 1}, "A": {"A": 1},
+            "N": {"kg": 1, "m": 1, "s": -2}, "J": {"kg": 1, "m": 2, "s": -2}, "W": {"kg": 1, "m": 2, "s": -3},
+            "Pa": {"kg": 1, "m": -1, "s": -2}}
+
+
+def _base_unit(u: str) -> dict | None:
+    """The FMI ``BaseUnit`` of a unit: from the table above, or parsed as a product of SI symbols
+    with integer powers (``/`` starts the denominator); ``None`` when it is not one (the unit is
+    then declared by name only, which FMI 2.0 allows)."""
+    if u in _UNITS:
+        return _UNITS[u]
+    import re
+
+    out: dict[str, int] = {}
+    num, _, den = u.partition("/")
+    for sign, part in ((1, num), (-1, den)):
+        for tok in part.replace(".", " ").replace("*", " ").split():
+            m = re.fullmatch(r"([A-Za-z]+)\^?(-?\d+)?", tok)
+            if tok == "1":
+                continue
+            if not m or m.group(1) not in _SYMBOLS:
+                return None
+            p = sign * int(m.group(2) or 1)
+            for k, e in _SYMBOLS[m.group(1)].items():
+                out[k] = out.get(k, 0) + e * p
+    return {k: e for k, e in out.items() if e}
+
+
 def _host_platform() -> str:
     """The FMI platform folder of this machine (linux64, win64, darwin64)."""
     bits = "64" if sys.maxsize > 2**32 else "32"
@@ -162,7 +192,9 @@ def _model_description(name: str, description: str, variables: list[dict[str, An
         units = ET.SubElement(root, "UnitDefinitions")
         for u in used:
             el = ET.SubElement(units, "Unit", {"name": u})
-            ET.SubElement(el, "BaseUnit", {k: str(e) for k, e in _UNITS[u].items()})
+            base = _base_unit(u)
+            if base is not None:
+                ET.SubElement(el, "BaseUnit", {k: str(e) for k, e in base.items()})
     ET.SubElement(root, "DefaultExperiment", {k: repr(float(v)) for k, v in experiment.items()})
     mv = ET.SubElement(root, "ModelVariables")
     outputs = []
@@ -269,8 +301,13 @@ def export(scenario: Any = None, out: str | os.PathLike[str] = "vessel.fmu", *,
         s = sc.Scenario.paper_fig2()
     elif isinstance(scenario, sc.Scenario):
         s = scenario
-    else:
+    elif isinstance(scenario, (str, os.PathLike)):
         s = sc.load(sc.resolve(scenario))
+    else:
+        raise _core.InvalidInputError(
+            f"export's scenario must be a phsplit.scenario.Scenario, a scenario file or a shipped scenario's name, "
+            f"or None for the paper's Fig. 2; got {type(scenario).__name__} (a Vessel goes in as "
+            f"phsplit.scenario.Scenario(vessel, settings))")
     st = s.settings
     sim = {"method": st.method, "h": float(st.h), "linear_flow": st.linear_flow, "outer": st.outer,
            "project_invariants": bool(st.project_invariants),
