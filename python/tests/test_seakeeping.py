@@ -105,3 +105,27 @@ def test_bad_arguments_are_refused_in_one_line_naming_the_argument(kwargs, words
     with pytest.raises(phsplit.InvalidInputError, match=words) as e:
         phsplit.rao(args.pop("vessel"), args.pop("frequencies"), args.pop("heading"), **args)
     assert "\n" not in str(e.value)
+
+
+def test_motion_statistics_of_a_regular_wave_run_are_those_of_its_sinusoid():
+    """Solution.motion_statistics over the steady state of a regular-wave run (the paper's vessel
+    as it is, head seas of 0.1 m at 0.44 rad/s): for a sinusoid of amplitude a, sigma = a/sqrt(2),
+    max = a and the significant double amplitude 4 sigma = 2 sqrt(2) a, a taken from the RAO fit
+    of the same run."""
+    paper = phsplit.Vessel.paper()
+    got, s = seakeeping.time_rao(paper, seakeeping.waves_table(paper), 0.44, 180.0, amplitude=0.1, t_end=600.0)
+    period = 2 * math.pi / 0.44
+    st = s.motion_statistics(after=600.0 - 10 * period)
+    for dof in ("heave", "pitch"):
+        a = 0.1 * abs(got[dof])
+        assert math.isclose(st[dof]["std"], a / math.sqrt(2), rel_tol=0.02), (dof, st[dof], a)
+        assert math.isclose(st[dof]["significant"], 2 * math.sqrt(2) * a, rel_tol=0.02)
+        assert math.isclose(st[dof]["max"], a + abs(st[dof]["mean"]), rel_tol=0.03)
+        assert st[dof]["rms"] >= st[dof]["std"]
+    assert st["roll"]["max"] < 1e-6   # head seas on a symmetric hull: no roll
+    whole = s.motion_statistics()
+    assert whole["heave"]["max"] >= st["heave"]["max"]
+    with pytest.raises(phsplit.InvalidInputError, match=r"^after must leave at least two saved samples"):
+        s.motion_statistics(after=601.0)
+    with pytest.raises(phsplit.InvalidInputError, match=r"^after must be a time in seconds"):
+        s.motion_statistics(after="end")
