@@ -107,6 +107,13 @@ def test_bad_arguments_are_refused_in_one_line_naming_the_argument(kwargs, words
     assert "\n" not in str(e.value)
 
 
+def test_a_vessel_off_the_frequency_domains_assumptions_is_refused():
+    d = phsplit.Vessel.paper().to_dict()
+    d["vessel"]["center_of_gravity"] = [0.0, 0.0, 0.5]
+    with pytest.raises(phsplit.InvalidInputError, match=r"^vessel: .* sets center_of_gravity$"):
+        phsplit.rao(phsplit.Vessel.from_dict(d), [0.56], 90.0)
+
+
 def test_motion_statistics_of_a_regular_wave_run_are_those_of_its_sinusoid():
     """Solution.motion_statistics over the steady state of a regular-wave run (the paper's vessel
     as it is, head seas of 0.1 m at 0.44 rad/s): for a sinusoid of amplitude a, sigma = a/sqrt(2),

@@ -163,6 +163,12 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
 
     if not isinstance(vessel, Vessel):
         raise _err(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
+    vp = vessel.to_dict()["vessel"]
+    off = [k for k in ("center_of_gravity", "flotation_center_x", "flotation_center_y")
+           if np.any(np.asarray(vp.get(k, 0.0), float) != 0.0)]
+    if off:
+        raise _err(f"vessel: the frequency-domain RAO here takes the centre of gravity and of flotation at the "
+                   f"origin, and this vessel sets {off[0]}")
     try:
         freqs = np.atleast_1d(np.asarray(frequencies, dtype=float))
     except (TypeError, ValueError):
