@@ -22,7 +22,8 @@ import time
 
 import numpy as np
 import phsplit
-from phsplit import hydro, radiation, sea
+from phsplit import radiation, seakeeping
+from phsplit.seakeeping import frequency_rao, waves_table
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATASET = os.path.join(HERE, "..", "python", "src", "phsplit", "scenarios", "paper_box_capytaine.nc")
@@ -34,62 +35,13 @@ AMPLITUDE = 0.1       # m
 T_END, STEP = 600.0, 0.5
 
 
-def linear_model(vessel):
-    """M (rigid body), D (linear damping) and C (restoring, linearised about upright; docs §2.3)
-    of a vessel without its added mass."""
-    p = vessel.to_dict()["vessel"]
-    m = p["mass"]
-    M = np.diag([m, m, m, *p["inertia"]])
-    D = np.diag([*p["damping_translational"], *p["damping_rotational"]])
-    g, rho = p["gravity"], p["water_density"]
-    C = np.diag([0.0, 0.0, rho * g * p["waterplane_area"], m * g * p["gm_transverse"],
-                 m * g * p["gm_longitudinal"], 0.0])
-    return M, D, C
-
-
-def frequency_rao(vessel, omega: float, direction: float, dataset=DATASET) -> np.ndarray:
-    """[−ω²(M + A(ω)) + iω(B(ω) + D) + C]⁻¹ F(ω) for a wave of unit amplitude (complex, 6 DOF),
-    at a frequency of the dataset."""
-    w, K, Ainf, _, out = radiation.retardation_data(dataset, vessel=vessel)
-    i = int(np.argmin(np.abs(w - omega)))
-    if abs(w[i] - omega) > 1e-9:
-        raise ValueError(f"{omega} rad/s is not a frequency of the dataset")
-    A = Ainf + K[i].imag / w[i]
-    B = K[i].real
-    wv = out["waves"]
-    j = int(np.argmin(np.abs(np.asarray(wv["rao_directions"]) - direction)))
-    F = np.asarray(wv["force_rao_real"])[j, i] + 1j * np.asarray(wv["force_rao_imag"])[j, i]
-    M, D, C = linear_model(vessel)
-    return np.linalg.solve(-omega ** 2 * (M + A) + 1j * omega * (B + D) + C, F)
-
-
 def time_rao(vessel_with_memory, waves_table, omega: float, direction: float, h: float = STEP,
              t_end: float = T_END, amplitude: float = AMPLITUDE):
-    """Heave (m/m), roll and pitch (rad/m) amplitudes after the transients, and the solution."""
-    d = vessel_with_memory.to_dict()
-    d["waves"] = {**waves_table, **sea.regular(amplitude, omega, direction=direction)}
-    v = phsplit.Vessel.from_dict(d)
-    y0 = v.initial_state(euler=[0.0, 0.0, 0.0], position=[0.0, 0.0, 0.0], velocity=[0.0, 0.0, 0.0],
-                         angular_velocity=[0.0, 0.0, 0.0])
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", phsplit.SettingWarning)
-        s = phsplit.simulate(v, (0.0, t_end), h, "sp4", control_start=None, initial=y0, save_every=1)
-    keep = s.t >= t_end - 10 * 2 * math.pi / omega
-    t = s.t[keep]
-    X = np.c_[np.cos(omega * t), np.sin(omega * t), np.ones_like(t)]
-    amp = []
-    for sig in (s.x[keep, 2], s.euler[keep, 0], s.euler[keep, 1]):
-        c, *_ = np.linalg.lstsq(X, sig, rcond=None)
-        amp.append(math.hypot(c[0], c[1]) / amplitude)
-    return np.array(amp), s
-
-
-def waves_table(vessel, dataset=DATASET) -> dict:
-    """The ``[waves]`` transfer functions of the dataset (first order only: no drift)."""
-    out = hydro.from_capytaine(dataset, symmetric=True, vessel=vessel)
-    return {k: out["waves"][k] for k in ("rao_frequencies", "rao_directions", "force_rao_real", "force_rao_imag")}
+    """Heave (m/m), roll and pitch (rad/m) amplitudes after the transients, and the solution
+    (phsplit.seakeeping.time_rao)."""
+    got, s = seakeeping.time_rao(vessel_with_memory, waves_table, omega, direction, amplitude=amplitude, h=h,
+                                 t_end=t_end, dofs=("heave", "roll", "pitch"))
+    return np.abs([got["heave"], got["roll"], got["pitch"]]), s
 
 
 def passivity(fm, omega=None) -> float:

@@ -40,6 +40,15 @@ class Field:
         h, c = params["vessel"], params["control"]
         self.mv = h["mass"]
         self.T = np.array(h["inertia"])
+        # the general vessel's added mass (docs §5.14) about the centre of gravity at the body
+        # origin: the momenta (p, m) = M nu with M = diag(m, m, m, I) + A, and Kirchhoff's
+        # equations p' = p x w + F, m' = m x w + p x v + T (Lamb, Hydrodynamics, §126)
+        self.Minv = None
+        if "added_mass" in h:
+            if np.any(np.array(h.get("center_of_gravity", [0.0] * 3), float) != 0.0):
+                raise NotImplementedError("the reference takes added mass only with the centre of gravity at the origin")
+            M = np.diag(np.concatenate([[self.mv] * 3, self.T])) + np.array(h["added_mass"], float)
+            self.Minv = np.linalg.inv(M)
         if "damping_matrix" in h:  # a full 6x6 linear damping on (v - v_c, w)
             self.D = np.array(h["damping_matrix"], float)
         else:
@@ -251,12 +260,19 @@ class Field:
             slope = np.zeros(6)
         return rows[k] + slope * max(t - times[k], 0.0), slope
 
+    def velocities(self, y):
+        """The body velocities (v, w) of the momenta y[0:6]."""
+        if self.Minv is None:
+            return y[0:3] / self.mv, y[3:6] / self.T
+        nu = self.Minv @ y[0:6]
+        return nu[:3], nu[3:]
+
     def ph_port(self, y):
         """The subsystem's (x, Qc x, u, y) at state y: its states, co-energy variables, input and output."""
         c = self.ph
         xc = y[c["at"]:c["at"] + c["n"]]
         e = c["Q"] @ xc
-        u = c["B"] @ np.concatenate([y[0:3] / self.mv, y[3:6] / self.T])
+        u = c["B"] @ np.concatenate(self.velocities(y))
         return xc, e, u, (c["G"] + c["P"]).T @ e + (c["N"] + c["S"]) @ u
 
     def ph_dissipation(self, y):
@@ -268,7 +284,7 @@ class Field:
     def __call__(self, t, y):
         p, m, Q = y[0:3], y[3:6], y[6:15].reshape(3, 3, order="F")
         mu, x, phth, phx = y[15:18], y[18:21], y[21:24], y[24:27]
-        v, w = p / self.mv, m / self.T
+        v, w = self.velocities(y)
         q3 = Q.T @ np.array([0.0, 0.0, 1.0])
         th = euler_zyx(Q)
         W = np.linalg.solve(pi_e(th), Q)
@@ -333,7 +349,7 @@ class Field:
             me = me + np.array([0.0, 0.0, mz])
         fd = self.D @ np.concatenate([vr, w])
         dy[0:3] = -np.cross(w, p) - (fd[:3] + self.cq[:3] * np.abs(vr) * vr + Q.T @ (self.lam * x) - tau_t) + fe
-        dy[3:6] = -np.cross(w, m) - (fd[3:] + self.cq[3:] * np.abs(w) * w + np.cross(mu, q3) - tau_r) + me
+        dy[3:6] = -np.cross(w, m) - (np.cross(v, p) if self.Minv is not None else 0.0) - (fd[3:] + self.cq[3:] * np.abs(w) * w + np.cross(mu, q3) - tau_r) + me
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)
         dy[18:21] = Q @ v
@@ -343,8 +359,8 @@ class Field:
 
     def control_torque(self, y):
         """The rotational control input tau_r (body frame, N m) at state y (zero when off)."""
-        m, Q, phth = y[3:6], y[6:15].reshape(3, 3, order="F"), y[21:24]
-        w = m / self.T
+        Q, phth = y[6:15].reshape(3, 3, order="F"), y[21:24]
+        w = self.velocities(y)[1]
         th = euler_zyx(Q)
         W = np.linalg.solve(pi_e(th), Q)
         K = self.K
@@ -353,7 +369,8 @@ class Field:
 
     def energy(self, y):
         p, m, mu, x = y[0:3], y[3:6], y[15:18], y[18:21]
-        h = 0.5 * m @ (m / self.T) + 0.5 * p @ p / self.mv + 0.5 * mu @ (self.Gp * mu) + 0.5 * self.lam[2] * x[2] ** 2
+        v, w = self.velocities(y)
+        h = 0.5 * m @ w + 0.5 * p @ v + 0.5 * mu @ (self.Gp * mu) + 0.5 * self.lam[2] * x[2] ** 2
         if self.ph is not None:  # the subsystem's storage, 1/2 x^T Qc x
             xc, e, _, _ = self.ph_port(y)
             h += 0.5 * xc @ e

@@ -3,7 +3,8 @@
 K(iw) = B + iw(A - A_inf) read again here with xarray; the subsystem's transfer matrix from its
 table's matrices, G^T Q (sI - (J - R)Q)^-1 G; the frequency-domain RAO
 [-w^2 (M + A(w)) + iw (B(w) + D) + C]^-1 F(w) written again from the dataset and the paper's
-vessel (Fossen 2021, ch. 5)."""
+vessel (Fossen 2021, ch. 5); for the orders, the independent model of tests/reference.py
+(eq. (39) in numpy with the subsystem and the added mass, by DOP853)."""
 from __future__ import annotations
 
 import copy
@@ -232,3 +233,77 @@ def test_the_scenario_key_switches_it_on_and_a_second_subsystem_is_refused(memor
     bad["environment"]["waves"]["fluid_memory"] = "yes"
     with pytest.raises(phsplit.ScenarioParseError, match="fluid_memory must be true or false"):
         scenario.from_dict(bad, scenario.resolve("dp-weather"))
+
+
+# -- orders against the independent model (tests/reference.py: eq. (39) in numpy with the
+# [port_hamiltonian] table and the added mass A_inf, by DOP853 at rtol 1e-13) ----------------
+
+ORDER_T_END = 2.0
+ORDER_HS = 2.0 ** -np.arange(1, 6)
+
+
+def kicked_start() -> np.ndarray:
+    """The paper's initial state with momenta in every direction (as test_port_hamiltonian's)."""
+    y0 = phsplit.Vessel.paper().initial_state()
+    y0[0:3] = [2e6, -1e6, 1e6]
+    y0[3:6] = [1e6, 2e6, -3e6]
+    return y0
+
+
+@pytest.fixture(scope="module")
+def reference_end(memory):
+    import reference as ref
+
+    vessel, fm = memory
+    _, y = ref.solve(vessel.to_dict(), kicked_start(), ORDER_T_END, 0.0, rtol=1e-13)
+    assert y.shape[1] == 27 + fm.n_states
+    return y[-1]
+
+
+@pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
+def test_orders_with_the_memory_against_the_independent_model(memory, reference_end, method, order):
+    """The paper's vessel with the whole 36-state memory and A_inf, the controller on from a kicked
+    start for 2 s: the largest relative error of p, m, x and the memory's states at the end, at
+    h = 1/2 ... 1/32 s, falls with the method's order (measured: slopes 1.994 and 3.996)."""
+    vessel, fm = memory
+    states = [f"radiation_{x}" for x in fm.table["states"]]
+    want = np.concatenate([reference_end[0:6], reference_end[18:21], reference_end[27:]])
+    errs = []
+    for h in ORDER_HS:
+        s = phsplit.simulate(vessel, (0.0, ORDER_T_END), h, method, control_start=0.0, ledger=False,
+                             initial=kicked_start(), project_invariants=False)
+        assert s.status == "completed" and s.t[-1] == ORDER_T_END
+        got = np.concatenate([s.p[-1], s.m[-1], s.x[-1], [s.outputs[k][2][-1] for k in states]])
+        errs.append(max(np.linalg.norm(got[a:b] - want[a:b]) / np.linalg.norm(want[a:b])
+                        for a, b in ((0, 3), (3, 6), (6, 9), (9, len(want)))))
+    errs = np.array(errs)
+    keep = errs > 1e-13
+    assert keep.sum() >= 3, errs
+    slope = np.polyfit(np.log(ORDER_HS[keep]), np.log(errs[keep]), 1)[0]
+    print(f"{method}: slope {slope:.3f}, errors {errs}")
+    assert abs(slope - order) < 0.3, (slope, errs)
+    assert errs[-1] < (1e-3 if order == 2 else 1e-7), errs
+
+
+def test_sp2_with_the_memory_in_a_sea_for_an_hour_within_its_passivity_bound():
+    """dp-weather (its JONSWAP sea, wind and current, DP on) with ``fluid_memory = true``, SP2 at
+    h = 1 s for one hour: the ledger closes per step, H(t) - H(0) <= supplied work, and the
+    account ``radiation`` books >= 0 in every interval (and something)."""
+    from checks import within_passivity_bound
+    from phsplit import scenario
+
+    data = scenario._read_toml(scenario.resolve("dp-weather"), "scenario file")
+    data["environment"]["waves"]["fluid_memory"] = True
+    data["simulation"].update(t_span=[0.0, 3600.0], h=1.0, method="sp2", save_every=1)
+    sc = scenario.from_dict(data, scenario.resolve("dp-weather"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", phsplit.SettingWarning)
+        s = phsplit.simulate(sc.vessel, settings=sc.settings)
+    assert s.status == "completed" and s.t[-1] == 3600.0 and len(s.t) == 3601
+    assert s.ledger.relative_residual().max() < 1e-10
+    assert within_passivity_bound(s)
+    booked = s.ledger.by_account["radiation"]
+    assert s.ledger.kinds["radiation"] == "dissipated"
+    assert np.all(booked[1:] >= 0.0) and booked.sum() > 0.0
+    print(f"residual {s.ledger.relative_residual().max():.2e}, radiation {booked.sum():.4g} J, "
+          f"H(T) - H(0) - supplied {s.energy[-1] - s.energy[0] - s.ledger.supplied.sum():.4g} J")

@@ -56,6 +56,7 @@ from .batch import simulate_many, with_parameters
 from .capability import capability
 from .results import open_dataset, open_sweep, rerun
 from .scenario import Scenario
+from .seakeeping import rao
 from .scenario import load as load_scenario
 from .simulate import (Ledger, ModelRangeWarning, PassivityWarning, SettingWarning, Settings, Solution, StepSizeWarning, Vessel,
                        presets, simulate)
@@ -90,6 +91,7 @@ __all__ = [
     "open_dataset",
     "open_sweep",
     "presets",
+    "rao",
     "rerun",
     "results",
     "rigid_body",

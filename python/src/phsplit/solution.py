@@ -182,6 +182,29 @@ class Solution:
         tail = [a[i] for a in (self.own, self.actuators) if a is not None]
         return np.concatenate([y, *tail]) if tail else y
 
+    def motion_statistics(self, after: float = 0.0) -> dict[str, dict[str, float]]:
+        """Statistics of heave (``x[:, 2]``, m), roll and pitch (``euler``, rad) over the saved
+        samples at ``t >= after`` (s; to leave out a start's transient): per DOF ``mean``,
+        ``std`` (σ, about the mean), ``rms`` (about zero: upright, the calm waterline), ``max``
+        (the largest ``|value|``) and ``significant`` = 4σ, the significant double amplitude
+        (crest to trough, the analogue of the significant wave height Hs; half of it is the
+        significant single amplitude). Sample statistics: the samples should be uniform in time
+        (``save_every``, not ``save_at``)."""
+        try:
+            after = float(after)
+        except (TypeError, ValueError):
+            raise _core.InvalidInputError(f"after must be a time in seconds, got {after!r}") from None
+        keep = self.t >= after
+        if not np.isfinite(after) or keep.sum() < 2:
+            raise _core.InvalidInputError(f"after must leave at least two saved samples (the run saved "
+                                          f"{self.t[0]:g}-{self.t[-1]:g} s), got {after!r}")
+        out = {}
+        for name, sig in (("heave", self.x[keep, 2]), ("roll", self.euler[keep, 0]), ("pitch", self.euler[keep, 1])):
+            std = float(np.std(sig))
+            out[name] = {"mean": float(np.mean(sig)), "std": std, "rms": float(np.sqrt(np.mean(sig ** 2))),
+                         "max": float(np.max(np.abs(sig))), "significant": 4.0 * std}
+        return out
+
     def settings_toml(self) -> str:
         """The run's settings as a ``[simulation]`` TOML table (what a scenario file takes)."""
         return settings_to_toml(self.settings)

@@ -1,0 +1,245 @@
+"""Response amplitude operators (RAOs) of a vessel in regular waves: in the time domain, by
+phsplit's own runs with a Capytaine dataset's first-order excitation (with or without Cummins'
+fluid memory, :mod:`phsplit.radiation`), against the frequency-domain RAO of the same dataset
+(docs/how-to/seakeeping-rao.md).
+
+The time domain: the vessel, controller off, from rest in one regular wave of ``amplitude`` at
+each frequency; the transients are discarded, and the amplitude and phase of each DOF come from
+a least-squares sinusoid ``c₀ + c₁ cos ωt + c₂ sin ωt`` over the last ``periods`` periods.
+
+The frequency domain (T. I. Fossen, *Handbook of Marine Craft Hydrodynamics and Motion Control*,
+2nd ed., 2021, ch. 5; the frequency-domain equation of motion):
+
+    ξ(ω) = [−ω² (M + A(ω)) + iω (B(ω) + D) + C]⁻¹ F(ω),
+
+``M`` the rigid body, ``D`` the vessel's linear damping, ``C`` its restoring linearised about
+upright (docs/model.md §2.3), and ``A``, ``B``, ``F`` the dataset's about the body origin
+(linear in ω between the dataset's frequencies, exact at them). Both are per unit wave
+amplitude, with the phase of ``Re(ξ e^{iωt})`` against the wave elevation ``a cos ωt`` where the
+waves' phases are taken (the set point; the output ``wave_elevation``)."""
+from __future__ import annotations
+
+import math
+import os
+import warnings
+
+import numpy as np
+
+from . import _core, cf, hydro, radiation, sea
+
+DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
+#: The shipped box of the paper's vessel (dp-weather's dataset).
+DEFAULT_DATASET = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios", "paper_box_capytaine.nc")
+_UNITS = {"surge": "m m-1", "sway": "m m-1", "heave": "m m-1", "roll": "rad m-1", "pitch": "rad m-1", "yaw": "rad m-1"}
+
+
+def _err(msg: str) -> _core.InvalidInputError:
+    return _core.InvalidInputError(msg)
+
+
+def linear_model(vessel):
+    """``(M, D, C)``: the rigid body's mass matrix (centre of gravity at the origin), the linear
+    damping (``damping_matrix`` or the diagonal) and the restoring linearised about upright
+    (docs/model.md §2.3) of a vessel, without its added mass."""
+    p = vessel.to_dict()["vessel"]
+    m = p["mass"]
+    M = np.diag([m, m, m, *p["inertia"]])
+    if "damping_matrix" in p:
+        D = np.array(p["damping_matrix"], float)
+    else:
+        D = np.diag([*p["damping_translational"], *p["damping_rotational"]])
+    g, rho = p["gravity"], p["water_density"]
+    C = np.diag([0.0, 0.0, rho * g * p["waterplane_area"], m * g * p["gm_transverse"],
+                 m * g * p["gm_longitudinal"], 0.0])
+    return M, D, C
+
+
+def waves_table(vessel, dataset=DEFAULT_DATASET) -> dict:
+    """The ``[waves]`` transfer functions of the dataset about the vessel's origin (first order
+    only: no drift)."""
+    out = hydro.from_capytaine(dataset, symmetric=True, vessel=vessel)
+    return {k: out["waves"][k] for k in ("rao_frequencies", "rao_directions", "force_rao_real", "force_rao_imag")}
+
+
+def frequency_rao(vessel, omega: float, heading: float, dataset=DEFAULT_DATASET, *, data=None) -> np.ndarray:
+    """``[−ω²(M + A(ω)) + iω(B(ω) + D) + C]⁻¹ F(ω)`` for a wave of unit amplitude (complex, the
+    six DOFs), ``A``, ``B``, ``F`` linear in ω between the dataset's frequencies. ``data``: the
+    :func:`phsplit.radiation.retardation_data` of the dataset and vessel, read once."""
+    w, K, Ainf, _, out = data if data is not None else radiation.retardation_data(dataset, vessel=vessel)
+    if not w[0] - 1e-9 <= omega <= w[-1] + 1e-9:
+        raise _err(f"frequencies: {omega:g} rad/s is outside the dataset's {w[0]:g}-{w[-1]:g} rad/s")
+    wv = out["waves"]
+    dirs = np.asarray(wv["rao_directions"], float)
+    gap = np.abs((dirs - heading + 180.0) % 360.0 - 180.0)   # the circular distance, degrees
+    j = int(np.argmin(gap))
+    if gap[j] > 1e-6:
+        raise _err(f"heading {heading:g} deg is not a direction of the dataset (with its mirror images: "
+                    f"{', '.join(f'{d:g}' for d in dirs)})")
+    A_all = Ainf + np.asarray(K).imag / w[:, None, None]
+    B_all = np.asarray(K).real
+    Fw = np.asarray(wv["force_rao_real"])[j] + 1j * np.asarray(wv["force_rao_imag"])[j]
+    i = int(np.searchsorted(w, omega))
+    if i < len(w) and abs(w[i] - omega) <= 1e-9:
+        A, B, F = A_all[i], B_all[i], Fw[i]
+    elif i > 0 and abs(w[i - 1] - omega) <= 1e-9:
+        A, B, F = A_all[i - 1], B_all[i - 1], Fw[i - 1]
+    else:
+        i = min(max(i, 1), len(w) - 1)
+        s = (omega - w[i - 1]) / (w[i] - w[i - 1])
+        A, B, F = ((1 - s) * X[i - 1] + s * X[i] for X in (A_all, B_all, Fw))
+    M, D, C = linear_model(vessel)
+    return np.linalg.solve(-omega ** 2 * (M + A) + 1j * omega * (B + D) + C, F)
+
+
+def _fit(t, sig, omega):
+    """The complex amplitude ``X`` of ``sig ≈ c₀ + Re(X e^{iωt})`` (least squares)."""
+    X = np.c_[np.cos(omega * t), np.sin(omega * t), np.ones_like(t)]
+    c, *_ = np.linalg.lstsq(X, sig, rcond=None)
+    return complex(c[0], -c[1])
+
+
+def time_rao(vessel, waves, omega: float, heading: float, *, amplitude: float = 0.1, h: float = 0.5,
+             t_end: float = 600.0, periods: float = 10.0, method: str = "sp4", dofs=DOFS):
+    """The complex amplitudes per unit wave amplitude (a dict by DOF: m/m, rad/m) of ``vessel``
+    (with its fluid memory if any) in one regular wave, from rest with the controller off, over
+    the last ``periods`` periods of ``t_end``, and the solution. ``waves``: :func:`waves_table`."""
+    from .simulate import SettingWarning, Vessel, simulate
+
+    d = vessel.to_dict()
+    d["waves"] = {**waves, **sea.regular(amplitude, omega, direction=heading)}
+    v = Vessel.from_dict(d, f"{vessel.source} in a regular wave")
+    zero = [0.0, 0.0, 0.0]
+    y0 = v.initial_state(euler=zero, position=zero, velocity=zero, angular_velocity=zero)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SettingWarning)
+        s = simulate(v, (0.0, t_end), h, method, control_start=None, initial=y0, save_every=1)
+    if s.status != "completed":
+        raise _core.IntegrationError(f"the run at {omega:g} rad/s did not complete: {s.failure}")
+    keep = s.t >= t_end - periods * 2 * math.pi / omega - 1e-9
+    t = s.t[keep]
+    signal = {"surge": s.x[keep, 0], "sway": s.x[keep, 1], "heave": s.x[keep, 2],
+              "roll": s.euler[keep, 0], "pitch": s.euler[keep, 1], "yaw": s.euler[keep, 2]}
+    # the phase against the wave elevation where the waves' phases are taken (the set point,
+    # docs/explanation/components/waves.md), its amplitude ``amplitude``
+    eta = _fit(t, np.asarray(s.outputs["wave_elevation"][2])[keep], omega)
+    ref = amplitude * eta / abs(eta)
+    return {k: _fit(t, signal[k], omega) / ref for k in dofs}, s
+
+
+def _positive(name, x):
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        raise _err(f"{name} must be a positive number, got {x!r}") from None
+    if not (math.isfinite(x) and x > 0):
+        raise _err(f"{name} must be a positive number, got {x!r}")
+    return x
+
+
+def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *, amplitude: float = 0.1,
+        dataset=None, fluid_memory=True, h: float = 0.5, t_end: float = 600.0, periods: float = 10.0,
+        method: str = "sp4"):
+    """The RAO of ``vessel`` at ``frequencies`` (rad/s) in regular waves from ``heading``
+    (degrees, the waves' direction relative to the bow: 90 beam seas, 180 head seas; a
+    direction of the dataset), in the time domain against the frequency domain, as an
+    ``xarray.Dataset`` along ``frequency`` with CF attributes.
+
+    Per DOF of ``dofs`` (of surge, sway, heave, roll, pitch, yaw): ``<dof>_amplitude`` and
+    ``<dof>_phase`` (the time domain: m/m or rad/m, and rad against the wave elevation where
+    the waves' phases are taken), ``<dof>_amplitude_frequency_domain`` and ``<dof>_phase_frequency_domain``,
+    ``<dof>_deviation`` (time over frequency domain, minus one); and per frequency the run's
+    ``ledger_residual`` (the largest relative residual) and ``radiation_dissipated`` (J, the
+    memory's account; zero without it).
+
+    ``dataset``: a Capytaine dataset (a path or an ``xarray.Dataset``; default the shipped box of
+    the paper's vessel, :data:`DEFAULT_DATASET`), whose first-order excitation drives the runs;
+    ``fluid_memory``: ``True`` (fit Cummins' memory here, :func:`phsplit.radiation.with_fluid_memory`),
+    a :class:`phsplit.radiation.FluidMemory` of the same dataset and vessel, or ``False`` (the
+    vessel as it is, its own added mass and damping); ``amplitude`` (m), the step ``h`` (s),
+    ``t_end`` (s), ``periods`` (the fit window) and ``method`` of the runs."""
+    import xarray as xr
+
+    from .simulate import Vessel
+
+    if not isinstance(vessel, Vessel):
+        raise _err(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
+    vp = vessel.to_dict()["vessel"]
+    off = [k for k in ("center_of_gravity", "flotation_center_x", "flotation_center_y")
+           if np.any(np.asarray(vp.get(k, 0.0), float) != 0.0)]
+    if off:
+        raise _err(f"vessel: the frequency-domain RAO here takes the centre of gravity and of flotation at the "
+                   f"origin, and this vessel sets {off[0]}")
+    try:
+        freqs = np.atleast_1d(np.asarray(frequencies, dtype=float))
+    except (TypeError, ValueError):
+        raise _err(f"frequencies must be positive numbers (rad/s), got {frequencies!r}") from None
+    if freqs.ndim != 1 or freqs.size == 0 or not np.all(np.isfinite(freqs)) or np.any(freqs <= 0):
+        raise _err(f"frequencies must be a non-empty list of positive numbers (rad/s), got {frequencies!r}")
+    try:
+        heading = float(heading)
+    except (TypeError, ValueError):
+        raise _err(f"heading must be a number (degrees), got {heading!r}") from None
+    if not math.isfinite(heading):
+        raise _err(f"heading must be a finite number (degrees), got {heading!r}")
+    if isinstance(dofs, str):
+        dofs = (dofs,)
+    dofs = tuple(dofs)
+    bad = [d for d in dofs if d not in DOFS]
+    if not dofs or bad or len(set(dofs)) != len(dofs):
+        raise _err(f"dofs must be distinct names of {', '.join(DOFS)}, got {list(dofs)!r}")
+    amplitude = _positive("amplitude", amplitude)
+    h = _positive("h", h)
+    t_end = _positive("t_end", t_end)
+    periods = _positive("periods", periods)
+    window = periods * 2 * math.pi / float(freqs.min())
+    if t_end < 2 * window:
+        raise _err(f"t_end must be at least twice the fit window ({periods:g} periods of the lowest frequency, "
+                   f"{window:.4g} s), so that the transients are discarded; got {t_end:g} s")
+    if method not in _core.METHODS:
+        raise _err(f"method must be one of {', '.join(_core.METHODS)}, got {method!r}")
+    dataset = DEFAULT_DATASET if dataset is None else dataset
+    data = radiation.retardation_data(dataset, vessel=vessel)
+    for w in freqs:   # refused before any run
+        frequency_rao(vessel, float(w), heading, dataset, data=data)
+    if fluid_memory is True:
+        td = radiation.with_fluid_memory(vessel, dataset)
+    elif isinstance(fluid_memory, radiation.FluidMemory):
+        td = radiation.with_fluid_memory(vessel, dataset, memory=fluid_memory)
+    elif fluid_memory is False:
+        td = vessel
+    else:
+        raise _err(f"fluid_memory must be True, False or a FluidMemory, got {type(fluid_memory).__name__}")
+    wt = waves_table(vessel, dataset)
+    n = len(freqs)
+    out = {k: np.zeros(n, complex) for k in dofs}
+    ref = {k: np.zeros(n, complex) for k in dofs}
+    residual, booked = np.zeros(n), np.zeros(n)
+    for i, w in enumerate(freqs):
+        got, s = time_rao(td, wt, float(w), heading, amplitude=amplitude, h=h, t_end=t_end, periods=periods,
+                          method=method, dofs=dofs)
+        fd = frequency_rao(vessel, float(w), heading, dataset, data=data)
+        for k in dofs:
+            out[k][i], ref[k][i] = got[k], fd[DOFS.index(k)]
+        residual[i] = float(s.ledger.relative_residual().max())
+        booked[i] = float(s.ledger.by_account["radiation"].sum()) if "radiation" in s.ledger.by_account else 0.0
+    variables = {}
+    for k in dofs:
+        u = _UNITS[k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dev = np.abs(out[k]) / np.abs(ref[k]) - 1.0
+        variables[f"{k}_amplitude"] = ("frequency", np.abs(out[k]), {"units": u, "long_name": f"{k} amplitude per unit wave amplitude, time domain"})
+        variables[f"{k}_phase"] = ("frequency", np.angle(out[k]), {"units": "rad", "long_name": f"{k} phase against the wave elevation, time domain"})
+        variables[f"{k}_amplitude_frequency_domain"] = ("frequency", np.abs(ref[k]), {"units": u, "long_name": f"{k} amplitude per unit wave amplitude, frequency domain"})
+        variables[f"{k}_phase_frequency_domain"] = ("frequency", np.angle(ref[k]), {"units": "rad", "long_name": f"{k} phase against the wave elevation, frequency domain"})
+        variables[f"{k}_deviation"] = ("frequency", dev, {"units": "1", "long_name": f"{k} time-domain amplitude over the frequency-domain one, minus one"})
+    variables["ledger_residual"] = ("frequency", residual, {"units": "1", "long_name": "largest relative residual of the run's ledger"})
+    variables["radiation_dissipated"] = ("frequency", booked, {"units": "J", "long_name": "energy booked by the fluid memory's account over the run"})
+    ds = xr.Dataset(variables, coords={"frequency": ("frequency", freqs, {"units": "rad s-1", "long_name": "wave angular frequency"})})
+    ds.attrs.update({"heading": heading, "heading_units": "degree (wave direction relative to the bow; 90 beam, 180 head seas)",
+                     "wave_amplitude": amplitude, "method": method, "step": h, "t_end": t_end, "fit_periods": periods,
+                     "fluid_memory": int(fluid_memory is not False),
+                     "dataset": dataset if isinstance(dataset, str) else "an xarray.Dataset",
+                     "comment": "time domain: phsplit runs from rest, controller off, a least-squares sinusoid over the last "
+                                "fit_periods periods; frequency domain: [-w^2 (M + A(w)) + iw (B(w) + D) + C]^-1 F(w) of the "
+                                "same dataset (Fossen 2021, ch. 5)"})
+    return cf.finish(ds, "phsplit RAO", "phsplit.rao")
