@@ -44,6 +44,8 @@ class Vessel:
         # What every run asks of the vessel (its TOML text, body, mass matrix, components,
         # natural periods), computed once: a vessel does not change after it is built.
         self._derived: dict[Any, Any] = {}
+        if inner.own_states():
+            _check_output_names(inner)
 
     def _once(self, key: Any, make):
         try:
@@ -181,3 +183,26 @@ def _vec3(name: str, v: Any) -> list[float]:
     if a.shape != (3,):
         raise _core.InvalidInputError(f"{name} must have 3 components, got shape {a.shape}")
     return [float(x) for x in a]
+
+
+#: The variables (and coordinates) of a run's dataset (``Solution.to_xarray``, the CLI's files)
+#: besides the components' outputs, and the prefixes of each ledger account's three.
+DATASET_VARIABLES = frozenset({
+    "time", "axis", "angle", "component", "row", "col", "state", "axis_name", "angle_name", "component_name",
+    "position", "euler", "quaternion", "attitude", "velocity", "velocity_spatial", "angular_velocity",
+    "linear_momentum", "angular_momentum", "mu", "phi_theta", "phi_x", "energy", "energy_supplied",
+    "energy_dissipated", "energy_residual", "orthogonality_defect", "control_force", "control_moment",
+    "initial_state"})
+ACCOUNT_PREFIXES = ("energy_", "force_", "moment_")
+
+
+def _check_output_names(inner: _core.Vessel) -> None:
+    """A subsystem's outputs are named after it and its states (``<name>_<state>``): none may
+    take the name of a variable the run's dataset holds already, which it would replace there."""
+    taken = set(DATASET_VARIABLES) | {p + a for a, _ in inner.accounts() for p in ACCOUNT_PREFIXES}
+    for name in inner.outputs(inner.initial_state(), 0.0):
+        if name in taken:
+            raise _core.InvalidInputError(
+                f"a port-Hamiltonian subsystem reports a quantity named {name!r}, the name of a variable the "
+                f"results already hold: rename the subsystem or its state (port_hamiltonian.name or "
+                f"port_hamiltonian.states)")
