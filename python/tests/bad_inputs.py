@@ -1086,3 +1086,21 @@ CATALOGUE += [
 
 def _scenario_beside_box(text: str):
     return scenario(text)()
+
+
+def _ph_dict(**keys) -> Callable[[], object]:
+    """The paper's vessel as a Python dict with a [port_hamiltonian] table (``keys`` replacing its own)."""
+    def run():
+        d = phsplit.Vessel.paper().to_dict()
+        d["port_hamiltonian"] = {"states": ["q", "pi"], "J": [[0.0, -1.0], [1.0, 0.0]], "R": [[0.0, 0.0], [0.0, 0.1]],
+                                 "Q": [[2.0, 0.0], [0.0, 1.0]], "G": [[1.0], [0.0]], "input": ["roll"], **keys}
+        return phsplit.Vessel.from_dict(d)
+    return run
+
+
+CATALOGUE += [
+    Bad("port-Hamiltonian Q with an integer beyond any float (Python dict)", _ph_dict(Q=[[10 ** 400, 0.0], [0.0, 1.0]]), E,
+        ("port_hamiltonian.Q[0][0]", "finite number", "too large")),
+    Bad("port-Hamiltonian J with a boolean (Python dict)", _ph_dict(J=[[False, -1.0], [1.0, 0.0]]), E,
+        ("port_hamiltonian.J[0][0]", "finite number")),
+]

@@ -100,7 +100,13 @@ class Vessel:
         """A vessel from a mapping of the tables of a vessel file (as ``to_dict()`` returns)."""
         if not isinstance(tables, Mapping):
             raise _core.InvalidInputError(f"a vessel is a mapping of tables, got {type(tables).__name__}")
-        return cls(_core.Vessel.from_dict(dict(tables)), source)
+        try:
+            inner = _core.Vessel.from_dict(dict(tables))
+        except OverflowError:  # a Python integer beyond any float, which the conversion cannot take
+            where = _too_large(tables, "")
+            raise _core.InvalidInputError(f"{where or 'a value'} must be a finite number, got an integer too large "
+                                          f"for a float") from None
+        return cls(inner, source)
 
     def to_toml(self) -> str:
         """Every parameter as TOML text; ``Vessel.from_toml_str`` rebuilds this vessel exactly."""
@@ -206,3 +212,24 @@ def _check_output_names(inner: _core.Vessel) -> None:
                 f"a port-Hamiltonian subsystem reports a quantity named {name!r}, the name of a variable the "
                 f"results already hold: rename the subsystem or its state (port_hamiltonian.name or "
                 f"port_hamiltonian.states)")
+
+
+def _too_large(x: Any, at: str) -> str | None:
+    """Where (``table.key[i][j]``) the first integer too large for a float is in ``x``."""
+    if isinstance(x, int) and not isinstance(x, bool):
+        try:
+            float(x)
+        except OverflowError:
+            return at
+        return None
+    if isinstance(x, Mapping):
+        for k, v in x.items():
+            found = _too_large(v, f"{at}.{k}" if at else str(k))
+            if found:
+                return found
+    elif isinstance(x, (list, tuple)):
+        for i, v in enumerate(x):
+            found = _too_large(v, f"{at}[{i}]")
+            if found:
+                return found
+    return None
