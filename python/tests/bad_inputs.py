@@ -958,3 +958,149 @@ CATALOGUE += [
     Bad("port-Hamiltonian dissipation block [[R, P], [Pᵀ, S]] that is indefinite",
         _ph(P="[[0.0], [1.0]]", S="[[1.0]]"), E, ("port_hamiltonian", "P", "S", "semidefinite")),
 ]
+
+# the subsystem's outputs against the results' own variables, and a record that does not fit
+
+
+CATALOGUE += [
+    Bad("port-Hamiltonian output named as a ledger variable", _ph(name='"energy"', states='["dissipated", "pi"]'), E,
+        ("energy_dissipated", "port_hamiltonian.name", "port_hamiltonian.states")),
+    Bad("port-Hamiltonian output named as a state variable", _ph(name='"phi"', states='["theta", "pi"]'), E,
+        ("phi_theta", "rename")),
+    Bad("rerun of a result whose vessel gained a port-Hamiltonian subsystem",
+        rerun_damaged({"phsplit_vessel": PAPER.replace("[initial]", "[port_hamiltonian]\n" + "".join(
+            f"{k} = {v}\n" for k, v in _PH.items()) + "[initial]", 1)}), E,
+        ("initial_state", "29", "own states", "port_hamiltonian_q")),
+    Bad("CLI: rerun of a result whose vessel gained a port-Hamiltonian subsystem",
+        on_result("rerun", "r.nc", attrs={"phsplit_vessel": PAPER.replace("[initial]", "[port_hamiltonian]\n" + "".join(
+            f"{k} = {v}\n" for k, v in _PH.items()) + "[initial]", 1)}), C, ("initial_state", "27 numbers", "29")),
+    Bad("port-Hamiltonian vessel run with a Runge–Kutta method", lambda: phsplit.simulate(_ph()(), (0.0, 1.0), 0.5, "rk4"),
+        E, ("port_hamiltonian", "splitting method")),
+    Bad("port-Hamiltonian state vector one own state short",
+        lambda: phsplit.simulate(_ph()(), (0.0, 1.0), 0.5, initial=np.r_[phsplit.Vessel.paper().initial_state(), 0.0]), E,
+        ("27", "29", "got 28")),
+]
+
+# ------------------------------------------------------------------------------------------
+# the static DP capability (phsplit.capability, phsplit capability)
+
+
+def _cap(**kw) -> Callable[[], object]:
+    return lambda: phsplit.capability("dp-capability", **{"directions": [0.0], "failures": "none", **kw})
+
+
+def _level1(col: int, row: int | slice, value: float) -> list[list[float]]:
+    from phsplit.capability import LEVEL1
+
+    t = [list(r) for r in LEVEL1]
+    for r in (range(len(t))[row] if isinstance(row, slice) else [row]):
+        t[r][col] = value
+    return t
+
+
+CATALOGUE += [
+    Bad("capability directions given as text", _cap(directions=["0", "90"]), E, ("directions", "numbers")),
+    Bad("capability directions given as booleans", _cap(directions=[True]), E, ("directions", "numbers")),
+    Bad("capability direction of 360 degrees", _cap(directions=[360.0]), E, ("directions", "[0, 360)")),
+    Bad("capability failure case named twice", _cap(failures=[[0], [0]]), E, ("failures", "[0]", "twice")),
+    Bad("capability failure of a thruster that does not exist", _cap(failures=[[9]]), E,
+        ("failures", "9", "0..3")),
+    Bad("capability tolerance of zero", _cap(tolerance=0.0), E, ("tolerance", "[1e-9, 1]")),
+    Bad("capability environment with Beaufort numbers that are not whole", _cap(environment=_level1(0, slice(None), 0.5)), E,
+        ("environment", "Beaufort", "whole numbers")),
+    Bad("capability environment with a sea state of no peak period", _cap(environment=_level1(3, 5, 0.0)), E,
+        ("environment", "Beaufort 5", "Tp 0", "calm row")),
+    Bad("capability environment with a peak period of 100 s", _cap(environment=_level1(3, 5, 100.0)), E,
+        ("environment", "Beaufort 5", "[0.5, 40]")),
+    Bad("capability environment with a current of 20 m/s", _cap(environment=_level1(4, 11, 20.0)), E,
+        ("environment", "current", "10 m/s")),
+    Bad("capability environment with winds to 100 m/s", _cap(environment=_level1(1, 11, 100.0)), E,
+        ("environment", "wind", "80 m/s")),
+    Bad("capability of a vessel without wind coefficients", lambda: phsplit.capability(phsplit.Vessel.paper()), E,
+        ("vessel", "[wind]")),
+    Bad("CLI: capability of a scenario without thrusters", cli("capability", "dp-weather", "--no-plot"), C,
+        ("[thrusters]",)),
+    Bad("CLI: capability into a folder that is a file", cli("capability", "dp-capability", "--out", "f", files={"f": b"x"}),
+        C, ("--out", "'f'", "is a file")),
+    Bad("CLI: capability onto a folder of the file's name",
+        cli("capability", "dp-capability", "--out", "o", files={"o": None, "o/dp-capability-capability.nc": None}),
+        C, ("dp-capability-capability.nc", "folder of that name")),
+    Bad("CLI: capability with a step that does not divide 360", cli("capability", "dp-capability", "--step", "7"), C,
+        ("--step", "divide 360", "7")),
+]
+
+# ------------------------------------------------------------------------------------------
+# the fluid memory (phsplit.radiation, fluid_memory = true)
+
+_BOX = os.path.join(os.path.dirname(phsplit.__file__), "scenarios", "paper_box_capytaine.nc")
+
+
+def _fm(**kw) -> Callable[[], object]:
+    from phsplit import radiation
+
+    return lambda: radiation.fluid_memory(_BOX, **kw)
+
+
+def _with_fm(vessel: Callable[[], object], **kw) -> Callable[[], object]:
+    from phsplit import radiation
+
+    return lambda: radiation.with_fluid_memory(vessel(), _BOX, **kw)
+
+
+_FM_SCENARIO = ('[simulation]\nt_span = [0.0, 2.0]\nh = 0.5\n[environment.waves]\nhs = 2.0\ntp = 8.0\n'
+                'omega_range = [0.35, 2.0]\nsymmetric = true\n')
+
+CATALOGUE += [
+    Bad("fluid memory with a negative coupling tolerance", _fm(coupling_tolerance=-1.0), E,
+        ("coupling_tolerance", "[0, 1)")),
+    Bad("fluid memory with a coupling tolerance as text", _fm(coupling_tolerance="small"), E,
+        ("coupling_tolerance", "[0, 1)", "small")),
+    Bad("fluid memory with no starting points", _fm(starts=0), E, ("starts", "1 to 100")),
+    Bad("fluid memory with refine as text", _fm(refine="yes"), E, ("refine", "true or false")),
+    Bad("fluid memory named with a space", _fm(name="my memory"), E, ("name", "letters, digits and underscores")),
+    Bad("fluid memory blocks for a group the dataset does not have", _fm(blocks={"sway_yaw": 2}), E,
+        ("blocks", "sway_yaw", "sway_roll")),
+    Bad("fluid memory blocks as text", _fm(blocks="many"), E, ("blocks", "'oscillator'", "many")),
+    Bad("fluid memory of a dataset without radiation damping",
+        lambda: __import__("phsplit.radiation").radiation.fluid_memory(
+            __import__("xarray").open_dataset(_BOX).drop_vars("radiation_damping")), E, ("radiation_damping",)),
+    Bad("fluid memory added to a vessel that has a subsystem", _with_fm(_ph()), E,
+        ("already has a port-Hamiltonian subsystem",)),
+    Bad("fluid memory with damping given as text", _with_fm(phsplit.Vessel.paper, damping={"damping_rotational": "x"}), E,
+        ("damping['damping_rotational']", "3 numbers")),
+    Bad("fluid memory of an existing fit with the fit's keywords",
+        lambda: __import__("phsplit.radiation").radiation.with_fluid_memory(
+            phsplit.Vessel.paper(), _BOX, memory=__import__("phsplit.radiation").radiation.fluid_memory(_BOX), starts=2),
+        E, ("memory", "starts", "fluid_memory()")),
+    Bad("scenario fluid memory given as text", scenario(_FM_SCENARIO + 'fluid_memory = "yes"\n'), P,
+        ("environment.waves.fluid_memory", "true or false", "yes")),
+    Bad("scenario fluid memory without a hydrodynamic dataset", scenario(_FM_SCENARIO + "fluid_memory = true\n"), P,
+        ("environment.waves.fluid_memory", "environment.waves.hydro")),
+    Bad("scenario fluid memory with an added mass of its own",
+        lambda: _scenario_beside_box(_FM_SCENARIO + f'fluid_memory = true\nhydro = "{_BOX}"\n[vessel]\nfrom = "paper"\n'
+                                     'added_mass = [[1e5, 0, 0, 0, 0, 0], [0, 1e5, 0, 0, 0, 0], [0, 0, 1e5, 0, 0, 0], '
+                                     '[0, 0, 0, 1e6, 0, 0], [0, 0, 0, 0, 1e6, 0], [0, 0, 0, 0, 0, 1e6]]\n'), E,
+        ("fluid_memory", "added_mass", "remove one")),
+]
+
+
+def _scenario_beside_box(text: str):
+    return scenario(text)()
+
+
+def _ph_dict(**keys) -> Callable[[], object]:
+    """The paper's vessel as a Python dict with a [port_hamiltonian] table (``keys`` replacing its own)."""
+    def run():
+        d = phsplit.Vessel.paper().to_dict()
+        d["port_hamiltonian"] = {"states": ["q", "pi"], "J": [[0.0, -1.0], [1.0, 0.0]], "R": [[0.0, 0.0], [0.0, 0.1]],
+                                 "Q": [[2.0, 0.0], [0.0, 1.0]], "G": [[1.0], [0.0]], "input": ["roll"], **keys}
+        return phsplit.Vessel.from_dict(d)
+    return run
+
+
+CATALOGUE += [
+    Bad("port-Hamiltonian Q with an integer beyond any float (Python dict)", _ph_dict(Q=[[10 ** 400, 0.0], [0.0, 1.0]]), E,
+        ("port_hamiltonian.Q[0][0]", "finite number", "too large")),
+    Bad("port-Hamiltonian J with a boolean (Python dict)", _ph_dict(J=[[False, -1.0], [1.0, 0.0]]), E,
+        ("port_hamiltonian.J[0][0]", "finite number")),
+]

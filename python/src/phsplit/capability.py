@@ -50,6 +50,10 @@ LOAD_ACCOUNTS = ("wind", "current", "crossflow_current")
 #: JONSWAP peak enhancement of the sea states.
 GAMMA = 3.3
 
+#: The core's largest wind speed (m/s, `wind.rs`) and current speed (m/s, `current.rs`).
+MAX_WIND = 80.0
+MAX_CURRENT = 10.0
+
 #: Components of the sea state's mean drift (equal bins in frequency).
 DRIFT_COMPONENTS = 200
 
@@ -75,6 +79,28 @@ class Environment:
             _bad("environment", "the wind speeds must start at 0 and increase row by row")
         if np.any(t[:, 2:] < 0):
             _bad("environment", "Hs, Tp and the current speed must be >= 0")
+        bf = t[:, 0]
+        if np.any(bf != np.round(bf)) or np.any(bf < 0) or np.any(np.diff(bf) <= 0):
+            _bad("environment", f"the Beaufort numbers (first column) must be whole numbers >= 0 that increase row by "
+                 f"row, got {bf.tolist()}")
+        if t[-1, 1] > MAX_WIND:
+            _bad("environment", f"the wind speeds must be at most {MAX_WIND:g} m/s (the core's limit), got {t[-1, 1]:g}")
+        if np.any(t[:, 4] > MAX_CURRENT):
+            _bad("environment", f"the current speeds must be at most {MAX_CURRENT:g} m/s (the core's limit), got "
+                 f"{t[:, 4].max():g}")
+        for r in t:
+            if r[2] > 0 and r[3] == 0:
+                _bad("environment", f"the row of Beaufort {int(r[0])} has Hs {r[2]:g} m and Tp 0: a Tp of 0 is for "
+                     f"a calm row (Hs 0) only")
+            if r[2] >= 1e-3:
+                from .sea import SeaState
+
+                try:
+                    SeaState(hs=float(r[2]), tp=float(r[3]), gamma=GAMMA)
+                except _core.InvalidInputError as e:
+                    _bad("environment", f"the row of Beaufort {int(r[0])} (Hs {r[2]:g} m, Tp {r[3]:g} s): {e}")
+        if t[-1, 3] == 0 and np.any(t[:, 2] > 0):
+            _bad("environment", "the last row's Tp must be > 0")
         self.table = t
         self.beaufort = t[:, 0].astype(int)
         self.wind = t[:, 1]
@@ -247,7 +273,9 @@ def _cases(failures: Any, n: int) -> list[tuple[str, list[int]]]:
                  f"thruster indices, got {failures!r}")
         return [("intact", [])] + [(f"thruster {i} lost", [i]) for i in range(n)]
     try:
-        groups = [list(g) for g in failures]
+        groups = [list(g) if not isinstance(g, (str, bytes)) else None for g in failures]
+        if any(g is None for g in groups):
+            raise TypeError
     except TypeError:
         _bad("failures", f"must be 'single', 'none', or a list of lists of thruster indices, got {failures!r}")
     out = [("intact", [])]
@@ -258,6 +286,8 @@ def _cases(failures: Any, n: int) -> list[tuple[str, list[int]]]:
         if bad:
             _bad("failures", f"thruster index {bad[0]} does not exist (the vessel has {n} thrusters, 0..{n - 1})")
         g = sorted({int(i) for i in g})
+        if any(c[1] == g for c in out):
+            _bad("failures", f"names the failure of thruster(s) {g} twice; each failure case once")
         out.append(("thrusters " + ", ".join(map(str, g)) + " lost" if len(g) > 1 else f"thruster {g[0]} lost", g))
     return out
 
@@ -265,6 +295,9 @@ def _cases(failures: Any, n: int) -> list[tuple[str, list[int]]]:
 def _directions(directions: Any) -> np.ndarray:
     if directions is None:
         return np.arange(0.0, 360.0, 10.0)
+    items = np.atleast_1d(np.asarray(directions, dtype=object)).ravel() if not isinstance(directions, Mapping) else []
+    if isinstance(directions, Mapping) or any(isinstance(x, (str, bytes, bool, np.bool_)) for x in items):
+        _bad("directions", f"must be numbers (degrees), got {directions!r}")
     try:
         d = np.asarray(directions, dtype=float)
     except (TypeError, ValueError):
@@ -318,6 +351,8 @@ def capability(vessel: Any, directions: Any = None, failures: Any = "single",
         vessel = vessel.vessel
     if not isinstance(vessel, Vessel):
         _bad("vessel", f"must be a phsplit.Vessel, a Scenario, or a scenario file or name, got {type(vessel).__name__}")
+    if isinstance(tolerance, (np.integer, np.floating)) and not isinstance(tolerance, np.bool_):
+        tolerance = float(tolerance)
     if not (isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool)
             and math.isfinite(tolerance) and 1e-9 <= tolerance <= 1.0):
         _bad("tolerance", f"must be a number in [1e-9, 1] (m/s), got {tolerance!r}")

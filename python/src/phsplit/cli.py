@@ -691,22 +691,31 @@ def _capability(args) -> int:
             raise
         raise type(e)(f"--vessel {args.vessel} with scenario {args.scenario}: {e}") from None
     out = args.out
+    # Every check of the output before the analysis runs (it may take minutes); the folder
+    # itself is made only once there is something to write into it.
     if os.path.exists(out) and not os.path.isdir(out):
         raise UsageError(f"--out {out!r} is a file, not a folder")
+    parent = out
+    while not os.path.exists(parent):
+        parent = os.path.dirname(os.path.abspath(parent))
+    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+        raise UsageError(f"cannot write into --out {out!r}: {parent!r} is not a writable folder")
+    stem = os.path.join(out, f"{sc.name}-capability")
+    nc, png = stem + ".nc", stem + ".png"
+    for f in (nc,) if args.no_plot else (nc, png):
+        if os.path.isdir(f):
+            raise UsageError(f"cannot write {f!r}: a folder of that name is in the way")
     ds = capability(sc.vessel, directions=directions, failures=args.failures, tolerance=args.tolerance)
     try:
         os.makedirs(out, exist_ok=True)
     except OSError as e:
         raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
-    if not os.access(out, os.W_OK | os.X_OK):
-        raise UsageError(f"output folder {out!r} is not writable")
-    stem = os.path.join(out, f"{sc.name}-capability")
-    nc, png = stem + ".nc", stem + ".png"
-    fd, tmp = tempfile.mkstemp(prefix=".capability-", suffix=".nc", dir=out)
-    os.close(fd)
+    from .files import publish, temporary_beside
+
+    tmp = temporary_beside(nc, prefix=".capability-")
     try:
         ds.to_netcdf(tmp)
-        os.replace(tmp, nc)
+        publish(tmp, nc)  # the usual permissions (mkstemp's are the owner's only)
     except BaseException:
         if os.path.exists(tmp):
             os.remove(tmp)
@@ -722,7 +731,14 @@ def _capability(args) -> int:
         print("note: the vessel has no wave drift coefficients; the mean wave drift is left out")
     print(f"wrote {os.path.abspath(nc)}")
     if not args.no_plot:
-        polar_plot(ds, png, title=f"{sc.name}: wind speed held (m/s)")
+        tmp = temporary_beside(png, prefix=".capability-")
+        try:  # under a temporary name, renamed when complete: no half-drawn figure on Ctrl-C
+            polar_plot(ds, tmp, title=f"{sc.name}: wind speed held (m/s)")
+            publish(tmp, png)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise
         print(f"wrote {os.path.abspath(png)}")
     return 0
 

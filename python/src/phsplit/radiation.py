@@ -367,6 +367,31 @@ def _fit_group(w, Kg, pairs, scale, kinds, refine=True, starts=6, seed=0, floor=
     return pars(x), S
 
 
+def _check_fit_keywords(blocks, coupling_tolerance, refine, name, rank_tolerance, starts) -> None:
+    """The keywords of :func:`fluid_memory`, checked before the dataset is read or a fit begins."""
+    import re
+
+    def fraction(key, x):
+        if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)) or not (
+                math.isfinite(x) and 0.0 <= x < 1.0):
+            raise _err(f"{key} must be a number in [0, 1) (relative to the largest entry), got {x!r}")
+
+    fraction("coupling_tolerance", coupling_tolerance)
+    fraction("rank_tolerance", rank_tolerance)
+    if not isinstance(refine, (bool, np.bool_)):
+        raise _err(f"refine must be true or false, got {refine!r}")
+    if isinstance(starts, bool) or not isinstance(starts, (int, np.integer)) or not 1 <= starts <= 100:
+        raise _err(f"starts must be a whole number of starting points from 1 to 100, got {starts!r}")
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", name):
+        raise _err(f"name must be a name of letters, digits and underscores that starts with a letter (it names "
+                   f"the subsystem's account and outputs), got {name!r}")
+    if blocks is not None and not isinstance(blocks, (int, list, tuple, dict)) or isinstance(blocks, bool):
+        raise _err(f"blocks must be a number of oscillators, a list of {', '.join(repr(k) for k in BLOCK_KINDS)}, "
+                   f"or a dict from a group's name (e.g. 'sway_roll') to either, got {blocks!r}")
+    if isinstance(blocks, dict) and not all(isinstance(k, str) for k in blocks):
+        raise _err(f"blocks' keys must be the names of DOF groups (e.g. 'sway_roll'), got {list(blocks)!r}")
+
+
 def _kinds(spec, gname: str, size: int) -> list[str]:
     if spec is None:
         spec = DEFAULT_BLOCKS
@@ -399,6 +424,7 @@ def fluid_memory(dataset, *, symmetric: bool = True, checks: str = "refuse", ves
     Refused (``InvalidInputError``, naming the coupling): a retardation that is not finite, a DOF
     whose retardation is zero (nothing to fit), a diagonal whose damping is negative at a
     frequency (a memory that would supply energy)."""
+    _check_fit_keywords(blocks, coupling_tolerance, refine, name, rank_tolerance, starts)
     w, K, Ainf, src, _ = retardation_data(dataset, symmetric=symmetric, checks=checks, vessel=vessel, a_inf=a_inf)
     if not np.all(np.isfinite(K)):
         _, a, b = np.argwhere(~np.isfinite(K))[0]
@@ -412,6 +438,14 @@ def fluid_memory(dataset, *, symmetric: bool = True, checks: str = "refuse", ves
             raise _err(f"the radiation damping of {coupling_name(a, a)} is negative at {w[neg[0]]:g} rad/s "
                        f"({K[neg[0], a, a].real:.4g}): a passive fluid memory cannot fit it")
     groups, keep, dropped = _groups(K, coupling_tolerance)
+    gnames = ["_".join(DOFS[a] for a in g) for g in groups]
+    if isinstance(blocks, dict):
+        unknown = sorted(set(blocks) - set(gnames))
+        if unknown:
+            raise _err(f"blocks names the group {unknown[0]!r}, which this dataset does not have; its groups of "
+                       f"coupled DOFs are {', '.join(gnames)}")
+    for g, gname in zip(groups, gnames):  # every group's blocks checked before any is fitted
+        _kinds(blocks, gname, len(g))
     all_blocks, S_list, by_group, report = [], [], {}, {}
     states: list[str] = []
     parts = []   # (J, R, Q, i, l6) per column
@@ -485,11 +519,6 @@ def with_fluid_memory(vessel, dataset, *, damping=None, memory: FluidMemory | No
     if "port_hamiltonian" in d:
         raise _err(f"the vessel already has a port-Hamiltonian subsystem ({d['port_hamiltonian'].get('name')!r}); "
                    f"a vessel holds one")
-    if memory is None:
-        memory = fluid_memory(dataset, symmetric=symmetric, checks=checks, vessel=vessel, **fit)
-    elif not isinstance(memory, FluidMemory):
-        raise _err(f"memory must be the FluidMemory of fluid_memory(), got {type(memory).__name__}")
-    d["vessel"]["added_mass"] = memory.added_mass_infinite.tolist()
     if damping is not None:
         if not isinstance(damping, dict):
             raise _err(f"damping must be a dict (damping_translational and/or damping_rotational), "
@@ -497,6 +526,24 @@ def with_fluid_memory(vessel, dataset, *, damping=None, memory: FluidMemory | No
         bad = sorted(set(damping) - {"damping_translational", "damping_rotational"})
         if bad:
             raise _err(f"damping takes damping_translational and damping_rotational, got {bad[0]!r}")
+        for k, x in damping.items():
+            try:
+                ok = len(x) == 3 and not isinstance(x, (str, bytes)) and all(
+                    isinstance(c, (int, float, np.integer, np.floating)) and not isinstance(c, (bool, np.bool_))
+                    for c in x)
+            except TypeError:
+                ok = False
+            if not ok:
+                raise _err(f"damping[{k!r}] must be 3 numbers (kg/s or kg m^2/s), got {x!r}")
+    if memory is None:
+        memory = fluid_memory(dataset, symmetric=symmetric, checks=checks, vessel=vessel, **fit)
+    elif not isinstance(memory, FluidMemory):
+        raise _err(f"memory must be the FluidMemory of fluid_memory(), got {type(memory).__name__}")
+    elif fit:
+        raise _err(f"memory is an existing fit, so the fit's keywords ({', '.join(sorted(fit))}) would not be used: "
+                   f"give them to fluid_memory(), or leave memory out")
+    d["vessel"]["added_mass"] = memory.added_mass_infinite.tolist()
+    if damping is not None:
         for k in ("damping_translational", "damping_rotational"):
             if k in damping:
                 d["vessel"][k] = [float(x) for x in damping[k]]

@@ -138,6 +138,14 @@ def check_record(ds) -> tuple[Vessel, Settings, np.ndarray, list[int]]:
     if y0.ndim != 1 or y0.size < n or not np.all(np.isfinite(y0)):
         raise _core.InvalidInputError(f"the file's initial_state variable is damaged: it must be at least {n} finite "
                                       f"numbers (the vessel's state), got shape {y0.shape}")
+    own = vessel.own_states
+    k = len(own)
+    if y0.size < n + k or (y0.size > n + k and "thrusters" not in vessel.to_dict()):
+        names = f" and its {k} own states ({', '.join(s[0] for s in own)})" if k else ""
+        raise _core.InvalidInputError(
+            f"the file's initial_state does not fit its vessel (phsplit_vessel): it holds {y0.size} numbers, the "
+            f"vessel's state {n + k}: the body's {n}{names}" + (", then the thrusters' memory" if "thrusters" in
+                                                               vessel.to_dict() else ""))
     chunks = _chunks_of(ds, settings)
     if ds.attrs.get("status") == "interrupted":
         steps = ds.attrs.get("steps")

@@ -269,11 +269,14 @@ class Solution:
         prov = self.meta.get("provenance", {})
         if "initial_state" in prov:
             y0 = prov["initial_state"]
+            tail = []
+            if self.own is not None and np.ndim(self.own) == 2 and np.shape(self.own)[1]:
+                tail.append(f"then the components' {np.shape(self.own)[1]} own states")
+            if len(y0) > 27 + (np.shape(self.own)[1] if tail else 0):
+                tail.append("then the rate-limited thrusters' memory: time, thrusts, angles in rad")
             data["initial_state"] = var(("state",), y0, "1",
-                                      "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; SI units)"
-                                      if len(y0) == 27 else
-                                      "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; then the "
-                                      "rate-limited thrusters' memory: time, thrusts, angles in rad; SI units)")
+                                      "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; "
+                                      + "".join(t + "; " for t in tail) + "SI units)")
         ds = xr.Dataset(data, coords=coords)
         ds["time"].encoding["_FillValue"] = None  # CF 2.5.1: no fill value on a coordinate
         # Time is the record (unlimited) dimension, as in the CLI's files: appendable, and the

@@ -44,6 +44,8 @@ class Vessel:
         # What every run asks of the vessel (its TOML text, body, mass matrix, components,
         # natural periods), computed once: a vessel does not change after it is built.
         self._derived: dict[Any, Any] = {}
+        if inner.own_states():
+            _check_output_names(inner)
 
     def _once(self, key: Any, make):
         try:
@@ -98,7 +100,13 @@ class Vessel:
         """A vessel from a mapping of the tables of a vessel file (as ``to_dict()`` returns)."""
         if not isinstance(tables, Mapping):
             raise _core.InvalidInputError(f"a vessel is a mapping of tables, got {type(tables).__name__}")
-        return cls(_core.Vessel.from_dict(dict(tables)), source)
+        try:
+            inner = _core.Vessel.from_dict(dict(tables))
+        except OverflowError:  # a Python integer beyond any float, which the conversion cannot take
+            where = _too_large(tables, "")
+            raise _core.InvalidInputError(f"{where or 'a value'} must be a finite number, got an integer too large "
+                                          f"for a float") from None
+        return cls(inner, source)
 
     def to_toml(self) -> str:
         """Every parameter as TOML text; ``Vessel.from_toml_str`` rebuilds this vessel exactly."""
@@ -181,3 +189,47 @@ def _vec3(name: str, v: Any) -> list[float]:
     if a.shape != (3,):
         raise _core.InvalidInputError(f"{name} must have 3 components, got shape {a.shape}")
     return [float(x) for x in a]
+
+
+#: The variables (and coordinates) of a run's dataset (``Solution.to_xarray``, the CLI's files)
+#: besides the components' outputs, and the prefixes of each ledger account's three.
+DATASET_VARIABLES = frozenset({
+    "time", "axis", "angle", "component", "row", "col", "state", "axis_name", "angle_name", "component_name",
+    "position", "euler", "quaternion", "attitude", "velocity", "velocity_spatial", "angular_velocity",
+    "linear_momentum", "angular_momentum", "mu", "phi_theta", "phi_x", "energy", "energy_supplied",
+    "energy_dissipated", "energy_residual", "orthogonality_defect", "control_force", "control_moment",
+    "initial_state"})
+ACCOUNT_PREFIXES = ("energy_", "force_", "moment_")
+
+
+def _check_output_names(inner: _core.Vessel) -> None:
+    """A subsystem's outputs are named after it and its states (``<name>_<state>``): none may
+    take the name of a variable the run's dataset holds already, which it would replace there."""
+    taken = set(DATASET_VARIABLES) | {p + a for a, _ in inner.accounts() for p in ACCOUNT_PREFIXES}
+    for name in inner.outputs(inner.initial_state(), 0.0):
+        if name in taken:
+            raise _core.InvalidInputError(
+                f"a port-Hamiltonian subsystem reports a quantity named {name!r}, the name of a variable the "
+                f"results already hold: rename the subsystem or its state (port_hamiltonian.name or "
+                f"port_hamiltonian.states)")
+
+
+def _too_large(x: Any, at: str) -> str | None:
+    """Where (``table.key[i][j]``) the first integer too large for a float is in ``x``."""
+    if isinstance(x, int) and not isinstance(x, bool):
+        try:
+            float(x)
+        except OverflowError:
+            return at
+        return None
+    if isinstance(x, Mapping):
+        for k, v in x.items():
+            found = _too_large(v, f"{at}.{k}" if at else str(k))
+            if found:
+                return found
+    elif isinstance(x, (list, tuple)):
+        for i, v in enumerate(x):
+            found = _too_large(v, f"{at}[{i}]")
+            if found:
+                return found
+    return None
