@@ -475,9 +475,28 @@ impl Model for VesselSystem<'_> {
     }
     fn runge_kutta_refused(&self) -> Option<String> {
         if self.own_dim > 0 {
-            let names: Vec<_> = self.vessel.own_layout().map(|(f, _)| f.name()).collect();
+            // Each component with states of its own, by the name its states are reported under
+            // (`tank_eta` is the subsystem `tank` of `port_hamiltonian`).
+            let names: Vec<String> = self
+                .vessel
+                .own_layout()
+                .map(|(f, _)| {
+                    let first = f.own_states().first().map_or("", |o| o.name.as_str());
+                    match f.accounts().first() {
+                        Some(a) if a.name != f.name() && first.starts_with(a.name) => {
+                            format!("{} (the subsystem {})", f.name(), a.name)
+                        }
+                        _ => f.name().to_string(),
+                    }
+                })
+                .collect();
+            let (what, verb) = if names.len() == 1 {
+                ("the component", "keeps states of its own")
+            } else {
+                ("the components", "keep states of their own")
+            };
             return Some(format!(
-                "the components {} keep states of their own, which the splitting methods integrate in flow S2 with the momenta and the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...)",
+                "{what} {} {verb}, which the splitting methods integrate in flow S2 with the momenta and the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...)",
                 names.join(", ")
             ));
         }
