@@ -939,6 +939,8 @@ def _ph(**keys: str) -> Callable[[], object]:
 
 
 CATALOGUE += [
+    Bad("port-Hamiltonian Q with entries beyond any subsystem's scale", _ph(Q="[[1e308, 0.0], [0.0, 1e308]]"), E,
+        ("port_hamiltonian.Q[0][0]", "within")),
     Bad("port-Hamiltonian J that is not skew", _ph(J="[[0.0, -1.0], [0.5, 0.0]]"), E, ("port_hamiltonian.J", "skew")),
     Bad("port-Hamiltonian R that is not symmetric", _ph(R="[[0.0, 0.1], [0.0, 0.1]]"), E,
         ("port_hamiltonian.R", "symmetric")),

@@ -48,6 +48,10 @@ pub const DOFS: [&str; 6] = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
 /// Largest number of states (a subsystem larger than this is not a component of a hull).
 pub const MAX_STATES: usize = 64;
 
+/// Largest magnitude of a matrix entry: the storage and the rows multiply entries by each other
+/// and by the states, which must stay finite (no physical subsystem comes near it).
+pub const MAX_ENTRY: f64 = 1e100;
+
 /// Largest distance of the input point from the body origin (m).
 pub const MAX_ARM: f64 = 1000.0;
 
@@ -147,10 +151,10 @@ fn matrix(
             m[(i, j)] = x
                 .as_float()
                 .or(x.as_integer().map(|v| v as f64))
-                .filter(|v| v.is_finite())
+                .filter(|v| v.abs() <= MAX_ENTRY)
                 .ok_or_else(|| {
                     Error::InvalidInput(format!(
-                        "{T}.{key}[{i}][{j}] must be a finite number, got {x}"
+                        "{T}.{key}[{i}][{j}] must be a finite number within ±{MAX_ENTRY:e} (the products of two entries and a state must stay finite), got {x}"
                     ))
                 })?;
         }
