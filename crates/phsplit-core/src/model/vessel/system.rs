@@ -101,6 +101,9 @@ pub struct VesselSystem<'a> {
     pub actuators: usize,
     /// How many states the components keep of their own ([`VesselState::own`]).
     pub own_dim: usize,
+    /// Each component with own states: its index in the vessel's components and its range in
+    /// [`VesselState::own`].
+    own_parts: Vec<(usize, std::ops::Range<usize>)>,
     /// The exact flow S2's balance beyond the structural one, per controller state and block
     /// system: computed once, at the upright attitude (`s2.rs`, `exact_balance`).
     exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
@@ -153,6 +156,7 @@ impl<'a> VesselSystem<'a> {
             gave_up: Default::default(),
             actuators: vessel.actuators(),
             own_dim: vessel.own_dim(),
+            own_parts: own::parts_of(vessel),
             exact_balance: Default::default(),
             s2_memo: Default::default(),
             accounts,

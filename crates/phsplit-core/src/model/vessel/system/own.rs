@@ -29,6 +29,34 @@ const MOMENTA: [usize; 6] = [0, 1, 2, 9, 10, 11];
 /// Most fixed-point passes over the forcing in one sub-step.
 const MAX_PASSES: usize = 200;
 
+/// Each component of `vessel` with own states: its index among the components and its range in
+/// [`VesselState::own`].
+pub(super) fn parts_of(vessel: &super::Vessel) -> Vec<(usize, std::ops::Range<usize>)> {
+    let mut off = 0;
+    let mut parts = Vec::new();
+    for (i, f) in vessel.forces.iter().enumerate() {
+        let n = f.own_states().len();
+        if n > 0 {
+            parts.push((i, off..off + n));
+            off += n;
+        }
+    }
+    parts
+}
+
+impl<'a> VesselSystem<'a> {
+    /// The components with own states, their linear parts and their columns in `w` (the
+    /// layout found once, in [`VesselSystem::new`]).
+    fn own_parts<'s>(
+        &'s self,
+    ) -> impl Iterator<Item = (usize, &'a OwnLinear, std::ops::Range<usize>)> + 's {
+        self.own_parts.iter().filter_map(|(i, r)| {
+            let l = self.vessel.forces[*i].own_linear()?;
+            Some((self.bases[*i] + l.account, l, 18 + r.start..18 + r.end))
+        })
+    }
+}
+
 impl VesselSystem<'_> {
     /// Flow S2 over `h` from time `t` for a vessel whose components keep states of their own:
     /// the body's block states and the own states together (module documentation).
@@ -96,23 +124,6 @@ impl VesselSystem<'_> {
         e
     }
 
-    /// The components with own states, their linear parts and their columns in `w`.
-    fn own_parts(&self) -> Vec<(usize, &OwnLinear, std::ops::Range<usize>)> {
-        self.vessel
-            .own_layout()
-            .filter_map(|(f, r)| {
-                let base = self
-                    .vessel
-                    .forces
-                    .iter()
-                    .position(|g| std::ptr::eq(g.as_ref(), f.as_ref()))
-                    .map_or(0, |i| self.bases[i]);
-                f.own_linear()
-                    .map(|l| (base + l.account, l, 18 + r.start..18 + r.end))
-            })
-            .collect()
-    }
-
     /// The own states' rates and their generalised force on the hull (body frame) at the block
     /// states `z` and own states `x` (flow S2's field, eq. 41, for them).
     pub(super) fn own_field(&self, z: &[Z3; 2], x: &[f64]) -> (Vec<f64>, [Vector3<f64>; 2]) {
@@ -141,7 +152,6 @@ impl VesselSystem<'_> {
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
         let nu = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
         self.own_parts()
-            .into_iter()
             .map(|(acc, l, r)| {
                 let xi = DVector::from_column_slice(&x[r.start - 18..r.end - 18]);
                 let tau = &l.fx * &xi + &l.fnu * &nu;
