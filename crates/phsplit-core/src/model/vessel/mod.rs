@@ -125,6 +125,13 @@ impl Vessel {
             forces,
             params,
         };
+        let i = &v.initial;
+        v.try_state_from(
+            i.euler.into(),
+            i.position.into(),
+            i.velocity.into(),
+            i.angular_velocity.into(),
+        )?;
         v.check_names()?;
         Ok(v)
     }
@@ -279,7 +286,36 @@ impl Vessel {
         for f in &self.forces {
             f.init_state(&mut s);
         }
+        if self.init_own(&mut s).is_err() {
+            s.own.fill(f64::NAN);
+        }
         s
+    }
+
+    /// [`Self::state_from`], with the error of a component that cannot set its own states from
+    /// the body's (the pipe's static shape that does not converge).
+    pub fn try_state_from(
+        &self,
+        euler: Vector3<f64>,
+        position: Vector3<f64>,
+        velocity: Vector3<f64>,
+        angular_velocity: Vector3<f64>,
+    ) -> Result<VesselState> {
+        let mut s = self.state_from(euler, position, velocity, angular_velocity);
+        self.init_own(&mut s)?;
+        Ok(s)
+    }
+
+    /// Let each component set its own states from the body's state in `s`
+    /// ([`Force::init_own`]).
+    fn init_own(&self, s: &mut VesselState) -> Result<()> {
+        let ranges: Vec<_> = self.own_layout().map(|(f, r)| (f.clone(), r)).collect();
+        for (f, r) in ranges {
+            let mut x = s.own[r.clone()].to_vec();
+            f.init_own(s, &mut x)?;
+            s.own[r].copy_from_slice(&x);
+        }
+        Ok(())
     }
 
     /// The default initial state of the file.
@@ -350,14 +386,22 @@ impl Vessel {
         if y.len() == state::STATE_DIM && !own.is_empty() {
             let mut v = y.to_vec();
             v.extend_from_slice(&own);
-            return VesselState::from_slice_continuing(&v, own.len(), self.actuators());
+            let mut s = VesselState::from_slice_continuing(&v, own.len(), self.actuators())?;
+            self.init_own(&mut s)?;
+            return Ok(s);
         }
         VesselState::from_slice_continuing(y, own.len(), self.actuators())
     }
 
     /// A state a user gives ([`VesselState::from_slice_user`]).
     pub fn user_state(&self, y: &[f64], orthonormalize: bool) -> Result<VesselState> {
-        VesselState::from_slice_user(y, orthonormalize, &self.own_initial(), self.actuators())
+        let mut s =
+            VesselState::from_slice_user(y, orthonormalize, &self.own_initial(), self.actuators())?;
+        if y.len() == state::STATE_DIM {
+            // The body's numbers alone: the components set their own states from them.
+            self.init_own(&mut s)?;
+        }
+        Ok(s)
     }
 
     /// The components' own states, in the layout's order ([`Self::own_layout`]).

@@ -19,7 +19,7 @@ use crate::flows::collocation::Z3;
 use crate::flows::rigid_body::MagnusOrder;
 use crate::lie::so3;
 use crate::methods::Flow;
-use crate::solve::{Account, FieldModel, Model, SplitModel, Work};
+use crate::solve::{Account, FieldModel, Model, Work};
 use nalgebra::{Matrix3, SVector, Vector3};
 
 mod memo;
@@ -29,6 +29,7 @@ mod power;
 mod report;
 mod s1;
 mod s2;
+mod split;
 
 /// How flow S2 (linear) is integrated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -101,9 +102,13 @@ pub struct VesselSystem<'a> {
     pub actuators: usize,
     /// How many states the components keep of their own ([`VesselState::own`]).
     pub own_dim: usize,
-    /// Each component with own states: its index in the vessel's components and its range in
-    /// [`VesselState::own`].
-    own_parts: Vec<(usize, std::ops::Range<usize>)>,
+    /// Each component with own states linear in flow S2: its index in the vessel's components,
+    /// its range in [`VesselState::own`] and its first column in the dense flow S2 (`own.rs`).
+    own_parts: Vec<(usize, std::ops::Range<usize>, usize)>,
+    /// How many own states are linear in flow S2 (the dense system's beyond the body's).
+    own_linear_dim: usize,
+    /// Each component with a flow of its own: its index and its range in [`VesselState::own`].
+    own_flowing: Vec<(usize, std::ops::Range<usize>)>,
     /// The exact flow S2's balance beyond the structural one, per controller state and block
     /// system: computed once, at the upright attitude (`s2.rs`, `exact_balance`).
     exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
@@ -121,6 +126,8 @@ pub(crate) enum GaveUp {
     Forcing = 2,
     /// Flow S2's stage system was singular.
     Singular = 3,
+    /// A component's own flow (the lumped-mass pipe's Newton iterations) did not converge.
+    OwnFlow = 4,
 }
 
 impl<'a> VesselSystem<'a> {
@@ -157,6 +164,8 @@ impl<'a> VesselSystem<'a> {
             actuators: vessel.actuators(),
             own_dim: vessel.own_dim(),
             own_parts: own::parts_of(vessel),
+            own_linear_dim: own::parts_of(vessel).iter().map(|p| p.1.len()).sum(),
+            own_flowing: own::flowing_of(vessel),
             exact_balance: Default::default(),
             s2_memo: Default::default(),
             accounts,
@@ -362,9 +371,13 @@ impl<'a> VesselSystem<'a> {
                 }
                 let mut own = Vec::new();
                 if self.own_dim > 0 {
-                    let (rates, tau) = self.own_field(&zs, &s.own);
+                    let (mut rates, tau) = self.own_field(&zs, &s.own);
                     ft[0] += tau[0];
                     fr[0] += tau[1];
+                    for (_, tau) in self.own_flow_field(&view, s, &mut rates) {
+                        ft[0] += tau[0];
+                        fr[0] += tau[1];
+                    }
                     own = rates;
                 }
                 VesselState {
@@ -430,6 +443,7 @@ impl Model for VesselSystem<'_> {
             1 => "flow S1 (Kirchhoff's equations for the general mass matrix) did not converge even in 1024 sub-steps: the rotation is far too fast for the step; take a shorter step".into(),
             2 => "the fixed point of flow S2's non-affine or time-dependent forces (quadratic or cross-flow drag, wind, waves, pipe, thrusters) did not converge: they change too much within the step; take a shorter step".into(),
             3 => "flow S2's collocation stage system was singular; take a shorter step".into(),
+            4 => "the lumped-mass pipe's implicit step (Newton's method on its discrete gradient) did not converge: its nodes move too far within the step; take a shorter step".into(),
             _ => return None,
         })
     }
@@ -513,54 +527,6 @@ impl Model for VesselSystem<'_> {
             f.project(s);
         }
         Work::default()
-    }
-}
-
-impl SplitModel for VesselSystem<'_> {
-    /// Flow S1 is exact for a mass matrix of the paper's form (the free rigid body's elliptic
-    /// flow), not for Kirchhoff's collocation; flow S2 is exact when it is the matrix
-    /// exponential (no forcing, `linear_flow = "exact"`), not when it is collocated. Nothing
-    /// merges with rate-limited thrusters.
-    fn merges_exactly(&self, flow: Flow) -> bool {
-        // Rate-limited thrusters write their memory at every step's end (`Model::end_step`):
-        // a sub-step merged across the boundary would skip it.
-        if self.actuators > 0 {
-            return false;
-        }
-        match flow {
-            Flow::S1 => self.vessel.body.kirchhoff.is_none(),
-            Flow::S2 => !self.forced && self.linear == LinearFlow::Exact,
-        }
-    }
-    fn supports_order(&self, order: usize) -> Result<()> {
-        if order > MAX_SUBFLOW_ORDER {
-            return Err(Error::InvalidInput(format!(
-                "a composition of order {order} needs sub-flows of order {order}; the vessel's flows provide order {MAX_SUBFLOW_ORDER} at most (Magnus 6, Gauss collocation with 3 stages)"
-            )));
-        }
-        Ok(())
-    }
-    fn flow(
-        &self,
-        which: Flow,
-        h: f64,
-        t_step: f64,
-        t: f64,
-        order: usize,
-        ledger: bool,
-        s: &mut VesselState,
-    ) -> Work {
-        match which {
-            Flow::S1 => {
-                let mo = MagnusOrder::for_order(order).expect("checked by supports_order");
-                self.flow_s1(s, h, mo);
-                Work::default()
-            }
-            Flow::S2 => {
-                let stages = order.div_ceil(2).max(1);
-                self.flow_s2(s, h, t, self.control_on(t_step), ledger, stages)
-            }
-        }
     }
 }
 

@@ -24,6 +24,8 @@
 //! with the body velocities in flow S2 ([`Force::own_linear`], [`OwnLinear`]); their storage
 //! is a part of H ([`Force::own_storage`]). The vessel lays them out after the body's 27
 //! numbers, integrates them with the momenta and reports them (`port_hamiltonian.rs`).
+//! States that evolve nonlinearly (a lumped-mass line's nodes) have a flow of their own
+//! ([`Force::own_flow`]), passive by itself and nested in flow S2 (`pipe/lumped.rs`).
 //!
 //! **Forcing**: a part of a force that is not affine in the block states at frozen attitude
 //! (the pipe's catenary tension as a function of the hang-off point's position), or that
@@ -43,11 +45,14 @@ use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use std::sync::Arc;
 
+pub use own::{OwnLinear, OwnState};
+
 pub mod crossflow;
 pub mod current;
 pub mod damping;
 pub mod damping_quadratic;
 pub mod external;
+mod own;
 pub mod pid;
 pub mod pipe;
 pub mod port_hamiltonian;
@@ -446,35 +451,6 @@ impl Output {
     }
 }
 
-/// One state a component keeps of its own ([`Force::own_states`]): its name in the results
-/// (unique among the vessel's outputs), CF unit, long name, and value where a run starts.
-#[derive(Debug, Clone, PartialEq)]
-pub struct OwnState {
-    pub name: String,
-    pub unit: String,
-    pub long_name: String,
-    pub initial: f64,
-}
-
-/// A component's own states in flow S2 ([`Force::own_linear`]), linear in them (`x`, the
-/// component's slice of [`VesselState::own`]) and in the body velocities `ν = (v, ω)`, with
-/// constant matrices: `x' = axx x + axnu ν`; its generalised force on the hull (body frame,
-/// force and moment about the body origin) `τ = fx x + fnu ν`; and the dissipation its account
-/// `account` (an index in [`Force::accounts`], a dissipated account) books,
-/// `[x; ν]ᵀ diss [x; ν]`. The exchange `ντ` with the hull is internal: what `τ` does to the
-/// kinetic energy the component's storage pays, less the dissipation (its contract, checked by
-/// the vessel's ledger tests: `d/dt(storage) = −ντ − [x; ν]ᵀ diss [x; ν]`). The vessel
-/// integrates these rows with the momenta as one linear system in flow S2 (`system/own.rs`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct OwnLinear {
-    pub axx: nalgebra::DMatrix<f64>,
-    pub axnu: nalgebra::DMatrix<f64>,
-    pub fx: nalgebra::DMatrix<f64>,
-    pub fnu: nalgebra::DMatrix<f64>,
-    pub account: usize,
-    pub diss: nalgebra::DMatrix<f64>,
-}
-
 /// A force or port of the vessel. See the module documentation for the contract.
 pub trait Force: Debug + Send + Sync {
     /// The component's name (its registration name).
@@ -530,6 +506,50 @@ pub trait Force: Debug + Send + Sync {
     /// Energy stored in its own states `x`, a part of H (J).
     fn own_storage(&self, _x: &[f64]) -> f64 {
         0.0
+    }
+    /// Whether its own states evolve by a flow of its own ([`Force::own_flow`]) instead of
+    /// linearly in flow S2 (a lumped-mass line's nodes).
+    fn has_own_flow(&self) -> bool {
+        false
+    }
+    /// Its own flow over `h` (> 0) at the frozen attitude `fr` from the body's state `s`:
+    /// advance its own states `x` and the body's momenta `u = (p, m)` (body frame) together, as
+    /// a passive system of its own (a discrete gradient: `pipe/chain.rs`), adding to `booked[k]`
+    /// the energy of its account `k` (J). The vessel nests it in flow S2 by Strang's rule
+    /// (docs/model.md §3.8). Returns `false` when its solver did not converge.
+    #[allow(clippy::too_many_arguments)]
+    fn own_flow(
+        &self,
+        _fr: &Frozen,
+        _s: &VesselState,
+        _h: f64,
+        _x: &mut [f64],
+        _u: &mut [Vector3<f64>; 2],
+        _booked: &mut [f64],
+    ) -> bool {
+        true
+    }
+    /// The rates of its own states `x` under its own flow at the body velocities `nu`, written
+    /// to `rates`, and its generalised force on the hull (body frame): its part of the vector
+    /// field (eq. 39), for the reference computations and tests.
+    fn own_rates(
+        &self,
+        _fr: &Frozen,
+        _x: &[f64],
+        _nu: &[Vector3<f64>; 2],
+        _rates: &mut [f64],
+    ) -> [Vector3<f64>; 2] {
+        [Vector3::zeros(); 2]
+    }
+    /// The account (an index in [`Force::accounts`]) under which its own flow's force on the
+    /// hull is reported ([`super::VesselSystem::account_wrenches`]).
+    fn own_hull_account(&self) -> Option<usize> {
+        None
+    }
+    /// Set its own states `x` from the body's state `s` where a run starts (the pipe's static
+    /// shape under the hang-off point); by default they keep their declared initial values.
+    fn init_own(&self, _s: &VesselState, _x: &mut [f64]) -> Result<()> {
+        Ok(())
     }
     /// The quantities it reports from its own states `x` (beyond the states themselves, which
     /// the vessel reports from [`Force::own_states`]).

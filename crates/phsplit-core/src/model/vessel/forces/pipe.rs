@@ -74,11 +74,22 @@ pub struct PipeState {
 /// Largest distance of the hang-off point from the body origin (m).
 pub const MAX_ARM: f64 = 1000.0;
 
-pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+pub mod chain;
+pub mod lumped;
+mod statics;
+
+/// The pipe's models (`pipe.model`): the quasi-static natural catenary (the default) or the
+/// dynamic lumped-mass line (`pipe/lumped.rs`).
+pub const MODELS: [&str; 2] = ["catenary", "lumped_mass"];
+
+pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
     const T: &str = "pipe";
     p.declare(T);
     if !p.has(T) {
         return Ok(None);
+    }
+    if p.choice(T, "model", &MODELS)? == "lumped_mass" {
+        return lumped::build(p, body).map(Some);
     }
     let weight = p.f64(T, "submerged_weight", "N/m", Range::Positive)?;
     let water_depth = p.f64(

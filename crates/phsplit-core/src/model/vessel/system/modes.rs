@@ -35,7 +35,7 @@ impl VesselSystem<'_> {
     /// (the hull with its subsystems: a tuned tank splits the roll mode in two).
     pub fn natural_periods(&self, q: &Matrix3<f64>, on: bool) -> Vec<f64> {
         let b = self.s2_at(q, on, false);
-        if self.own_dim > 0 {
+        if self.own_linear_dim > 0 {
             return self.natural_periods_own(&b);
         }
         // The 18×18 system (the two block systems and what couples them), without the

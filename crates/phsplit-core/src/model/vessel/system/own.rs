@@ -29,31 +29,110 @@ const MOMENTA: [usize; 6] = [0, 1, 2, 9, 10, 11];
 /// Most fixed-point passes over the forcing in one sub-step.
 const MAX_PASSES: usize = 200;
 
-/// Each component of `vessel` with own states: its index among the components and its range in
-/// [`VesselState::own`].
-pub(super) fn parts_of(vessel: &super::Vessel) -> Vec<(usize, std::ops::Range<usize>)> {
+/// Each component of `vessel` whose own states evolve linearly in flow S2 ([`OwnLinear`]): its
+/// index among the components, its range in [`VesselState::own`], and where its columns start
+/// in the dense system's `w` (after the 18 block states; the states of components with a flow
+/// of their own are not in it: flow S2 leaves them alone).
+pub(super) fn parts_of(vessel: &super::Vessel) -> Vec<(usize, std::ops::Range<usize>, usize)> {
     let mut off = 0;
+    let mut col = 18;
     let mut parts = Vec::new();
     for (i, f) in vessel.forces.iter().enumerate() {
         let n = f.own_states().len();
-        if n > 0 {
-            parts.push((i, off..off + n));
-            off += n;
+        if n > 0 && f.own_linear().is_some() {
+            parts.push((i, off..off + n, col));
+            col += n;
         }
+        off += n;
     }
     parts
 }
 
+/// Each component with a flow of its own ([`super::super::forces::Force::own_flow`]): its index
+/// among the components and its range in [`VesselState::own`].
+pub(super) fn flowing_of(vessel: &super::Vessel) -> Vec<(usize, std::ops::Range<usize>)> {
+    let mut off = 0;
+    let mut parts = Vec::new();
+    for (i, f) in vessel.forces.iter().enumerate() {
+        let n = f.own_states().len();
+        if n > 0 && f.has_own_flow() {
+            parts.push((i, off..off + n));
+        }
+        off += n;
+    }
+    parts
+}
+
+/// A linear own-state component in flow S2: its account, its rows, its columns in `w` and its
+/// range in [`VesselState::own`].
+pub(super) struct LinearPart<'a> {
+    pub account: usize,
+    pub rows: &'a OwnLinear,
+    pub cols: std::ops::Range<usize>,
+    pub own: std::ops::Range<usize>,
+}
+
 impl<'a> VesselSystem<'a> {
-    /// The components with own states, their linear parts and their columns in `w` (the
-    /// layout found once, in [`VesselSystem::new`]).
-    fn own_parts<'s>(
-        &'s self,
-    ) -> impl Iterator<Item = (usize, &'a OwnLinear, std::ops::Range<usize>)> + 's {
-        self.own_parts.iter().filter_map(|(i, r)| {
+    /// The components whose own states are linear in flow S2 (the layout found once, in
+    /// [`VesselSystem::new`]).
+    fn own_parts<'s>(&'s self) -> impl Iterator<Item = LinearPart<'a>> + 's {
+        self.own_parts.iter().filter_map(|(i, r, col)| {
             let l = self.vessel.forces[*i].own_linear()?;
-            Some((self.bases[*i] + l.account, l, 18 + r.start..18 + r.end))
+            Some(LinearPart {
+                account: self.bases[*i] + l.account,
+                rows: l,
+                cols: *col..*col + r.len(),
+                own: r.clone(),
+            })
         })
+    }
+
+    /// The components' own flows over `h` at the attitude of `s` (each advancing its own
+    /// states and the body's momenta), with their accounts' energy.
+    pub(super) fn own_flows(&self, s: &mut VesselState, h: f64, on: bool) -> Work {
+        let mut work = Work::default();
+        if h == 0.0 {
+            return work;
+        }
+        let fr = self.frozen(s, on);
+        let mut u = [s.p, s.m];
+        for (i, r) in &self.own_flowing {
+            let f = &self.vessel.forces[*i];
+            let mut booked = vec![0.0; f.accounts().len()];
+            let mut x = s.own[r.clone()].to_vec();
+            if !f.own_flow(&fr, s, h, &mut x, &mut u, &mut booked) {
+                self.give_up(GaveUp::OwnFlow);
+                s.p = Vector3::from_element(f64::NAN);
+                return work;
+            }
+            s.own[r.clone()].copy_from_slice(&x);
+            for (k, e) in booked.into_iter().enumerate() {
+                work.add(self.bases[*i] + k, e);
+            }
+        }
+        s.p = u[0];
+        s.m = u[1];
+        work
+    }
+
+    /// The rates of the own states of the components with a flow of their own, added to
+    /// `rates` (indexed as [`VesselState::own`]), and their force on the hull, at `s`.
+    pub(super) fn own_flow_field(
+        &self,
+        fr: &Frozen,
+        s: &VesselState,
+        rates: &mut [f64],
+    ) -> Vec<(usize, [Vector3<f64>; 2])> {
+        let nu = self.vessel.body.velocity(&s.p, &s.m);
+        self.own_flowing
+            .iter()
+            .map(|(i, r)| {
+                let f = &self.vessel.forces[*i];
+                let tau = f.own_rates(fr, &s.own[r.clone()], &nu, &mut rates[r.clone()]);
+                let acc = self.bases[*i] + f.own_hull_account().unwrap_or(0);
+                (acc, tau)
+            })
+            .collect()
     }
 }
 
@@ -79,14 +158,14 @@ impl VesselSystem<'_> {
                 self.dense_exact(b, &a, &w0, h)
             }
         });
-        let (z1, x1) = self.unpack(&w1);
+        let (z1, x1) = self.unpack(&w1, &s.own);
         self.set_blocks(s, &z1);
         s.own = x1;
         work
     }
 
     fn dim(&self) -> usize {
-        19 + self.own_dim
+        19 + self.own_linear_dim
     }
 
     fn pack(&self, z: &[Z3; 2], x: &[f64]) -> DVector<f64> {
@@ -96,16 +175,26 @@ impl VesselSystem<'_> {
                 w.rows_mut(9 * k + 3 * i, 3).copy_from(&z[k][i]);
             }
         }
-        w.rows_mut(18, x.len()).copy_from_slice(x);
+        for p in self.own_parts() {
+            w.rows_mut(p.cols.start, p.cols.len())
+                .copy_from_slice(&x[p.own]);
+        }
         w[self.dim() - 1] = 1.0;
         w
     }
 
-    fn unpack(&self, w: &DVector<f64>) -> ([Z3; 2], Vec<f64>) {
+    /// The block states of `w`, and the own states: those of `x` with the linear ones from `w`.
+    fn unpack(&self, w: &DVector<f64>, x: &[f64]) -> ([Z3; 2], Vec<f64>) {
         let z = std::array::from_fn(|k| {
             std::array::from_fn(|i| Vector3::from_column_slice(&w.as_slice()[9 * k + 3 * i..][..3]))
         });
-        (z, w.as_slice()[18..18 + self.own_dim].to_vec())
+        let mut own = x.to_vec();
+        if !own.is_empty() {
+            for p in self.own_parts() {
+                own[p.own].copy_from_slice(&w.as_slice()[p.cols]);
+            }
+        }
+        (z, own)
     }
 
     /// `ν = E w` (6 × N), through the full `M⁻¹`.
@@ -131,11 +220,11 @@ impl VesselSystem<'_> {
         let nu = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
         let mut rates = vec![0.0; x.len()];
         let mut tau = DVector::<f64>::zeros(6);
-        for (_, l, r) in self.own_parts() {
-            let (a, b) = (r.start - 18, r.end - 18);
-            let xi = DVector::from_column_slice(&x[a..b]);
+        for p in self.own_parts() {
+            let l = p.rows;
+            let xi = DVector::from_column_slice(&x[p.own.clone()]);
             let d = &l.axx * &xi + &l.axnu * &nu;
-            rates[a..b].copy_from_slice(d.as_slice());
+            rates[p.own].copy_from_slice(d.as_slice());
             tau += &l.fx * &xi + &l.fnu * &nu;
         }
         (
@@ -152,11 +241,12 @@ impl VesselSystem<'_> {
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
         let nu = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
         self.own_parts()
-            .map(|(acc, l, r)| {
-                let xi = DVector::from_column_slice(&x[r.start - 18..r.end - 18]);
+            .map(|p| {
+                let l = p.rows;
+                let xi = DVector::from_column_slice(&x[p.own]);
                 let tau = &l.fx * &xi + &l.fnu * &nu;
                 (
-                    acc,
+                    p.account,
                     [
                         Vector3::new(tau[0], tau[1], tau[2]),
                         Vector3::new(tau[3], tau[4], tau[5]),
@@ -179,7 +269,8 @@ impl VesselSystem<'_> {
             a[(i, c)] = full[(i, 18)];
         }
         let e = self.velocity_map();
-        for (_, l, r) in self.own_parts() {
+        for p in self.own_parts() {
+            let (l, r) = (p.rows, p.cols);
             let m = r.len();
             let mut rows = a.view_mut((r.start, r.start), (m, m));
             rows += &l.axx;
@@ -217,7 +308,8 @@ impl VesselSystem<'_> {
             }
         }
         let e = self.velocity_map();
-        for (acc, l, r) in self.own_parts() {
+        for p in self.own_parts() {
+            let (acc, l, r) = (p.account, p.rows, p.cols);
             // [x; ν] = T w; the dissipation is booked as a positive number.
             let m = r.len();
             let mut t = DMatrix::zeros(m + 6, n);
@@ -380,7 +472,7 @@ impl VesselSystem<'_> {
         for pass in 0..MAX_PASSES {
             if self.forced {
                 for i in 0..s {
-                    let (z, _) = self.unpack(&unscale(&ys[i]));
+                    let (z, _) = self.unpack(&unscale(&ys[i]), &[]);
                     forcings[i].clear();
                     self.add_forcing_of(fr, t + nodes[i] * h, &z, None, &mut forcings[i]);
                     let g = &forcings[i].g;
@@ -445,7 +537,7 @@ impl VesselSystem<'_> {
                 let p = Work::from_fn(self.accounts.len(), |acc| y.dot(&(&forms[acc] * &y)));
                 let mut p = p;
                 if self.forced {
-                    let (z, _) = self.unpack(&y);
+                    let (z, _) = self.unpack(&y, &[]);
                     p += self.forcing_power(&[&forcings[i]], &z);
                 }
                 work += p.scaled(h * bw[i]);

@@ -61,7 +61,12 @@ impl VesselSystem<'_> {
             .collect();
         b.add_cross_booked(&z, &mut f);
         // A subsystem's force on the hull (its account books what it dissipates).
-        for (acc, w) in self.own_wrenches(&z, &s.own) {
+        let mut rates = vec![0.0; s.own.len()];
+        let own = self.own_wrenches(&z, &s.own);
+        for (acc, w) in own
+            .into_iter()
+            .chain(self.own_flow_field(&fr, s, &mut rates))
+        {
             f[acc][0] += w[0];
             f[acc][1] += w[1];
         }

@@ -40,7 +40,7 @@ impl VesselSystem<'_> {
         ledger: bool,
         stages: usize,
     ) -> Work {
-        if self.own_dim > 0 {
+        if self.own_linear_dim > 0 {
             return self.flow_s2_own(s, h, t, on, ledger, stages);
         }
         let z0 = self.blocks_of(s);

@@ -1,0 +1,75 @@
+//! The vessel as a split model: its flows S1 and S2 (the components' own flows nested in S2) and
+//! what merges and which orders they provide (docs/model.md §3).
+
+use super::super::state::VesselState;
+use super::{LinearFlow, MagnusOrder, VesselSystem, MAX_SUBFLOW_ORDER};
+use crate::error::{Error, Result};
+use crate::methods::Flow;
+use crate::solve::{SplitModel, Work};
+
+impl SplitModel for VesselSystem<'_> {
+    /// Flow S1 is exact for a mass matrix of the paper's form (the free rigid body's elliptic
+    /// flow), not for Kirchhoff's collocation; flow S2 is exact when it is the matrix
+    /// exponential (no forcing, `linear_flow = "exact"`), not when it is collocated. Nothing
+    /// merges with rate-limited thrusters.
+    fn merges_exactly(&self, flow: Flow) -> bool {
+        // Rate-limited thrusters write their memory at every step's end (`Model::end_step`):
+        // a sub-step merged across the boundary would skip it.
+        if self.actuators > 0 {
+            return false;
+        }
+        match flow {
+            Flow::S1 => self.vessel.body.kirchhoff.is_none(),
+            Flow::S2 => {
+                !self.forced && self.linear == LinearFlow::Exact && self.own_flowing.is_empty()
+            }
+        }
+    }
+    fn supports_order(&self, order: usize) -> Result<()> {
+        if order > 2 && !self.own_flowing.is_empty() {
+            return Err(Error::InvalidInput(format!(
+                "a composition of order {order} needs sub-flows of order {order}; the lumped-mass pipe's flow is nested in flow S2 by Strang's rule, of order 2: use lie or sp2 (or pipe.model = \"catenary\")"
+            )));
+        }
+        if order > MAX_SUBFLOW_ORDER {
+            return Err(Error::InvalidInput(format!(
+                "a composition of order {order} needs sub-flows of order {order}; the vessel's flows provide order {MAX_SUBFLOW_ORDER} at most (Magnus 6, Gauss collocation with 3 stages)"
+            )));
+        }
+        Ok(())
+    }
+    fn flow(
+        &self,
+        which: Flow,
+        h: f64,
+        t_step: f64,
+        t: f64,
+        order: usize,
+        ledger: bool,
+        s: &mut VesselState,
+    ) -> Work {
+        match which {
+            Flow::S1 => {
+                let mo = MagnusOrder::for_order(order).expect("checked by supports_order");
+                self.flow_s1(s, h, mo);
+                Work::default()
+            }
+            Flow::S2 => {
+                let stages = order.div_ceil(2).max(1);
+                let on = self.control_on(t_step);
+                if self.own_flowing.is_empty() {
+                    return self.flow_s2(s, h, t, on, ledger, stages);
+                }
+                // The components' own flows nested by Strang's rule, S2(h/2) S3(h) S2(h/2):
+                // one own flow per sub-step (their Newton iterations cost more than S2).
+                let mut w = self.flow_s2(s, 0.5 * h, t, on, ledger, stages);
+                w += &self.own_flows(s, h, on);
+                if !s.p.x.is_finite() {
+                    return w;
+                }
+                w += &self.flow_s2(s, 0.5 * h, t + 0.5 * h, on, ledger, stages);
+                w
+            }
+        }
+    }
+}
