@@ -9,6 +9,7 @@ mod capability;
 mod convert;
 mod fmu;
 mod numerics;
+mod pipe;
 mod run;
 
 use convert::{entries, from_toml, to_table};
@@ -398,6 +399,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyVessel>()?;
     run::register(m)?;
     capability::register(m)?;
+    pipe::register(m)?;
     m.add_function(wrap_pyfunction!(method_info, m)?)?;
     m.add_function(wrap_pyfunction!(fmu::fmu_variables, m)?)?;
     m.add_function(wrap_pyfunction!(euler_zyx, m)?)?;

@@ -263,6 +263,14 @@ def dp_figure(ds, watch_circle: float | None = None, title: str | None = None):
                 ax_pipe.plot(t, np.hypot(fs[:, 0], fs[:, 1]) / 1e3, **_style(k, len(t)), label=a)
             ax_pipe.set_ylabel("horizontal force by source [kN]")
             _legend_outside(ax_pipe, ncol=len(env))
+        elif piped and "pipe_departure_angle" not in ds:
+            # The dynamic (lumped-mass) pipe: the tensions at its ends and its suspended length.
+            ax_pipe.plot(t, ds["pipe_top_tension"].values / 1e3, **_style(0, len(t)), label="top tension [kN]")
+            ax_pipe.plot(t, ds["pipe_anchor_tension"].values / 1e3, **_style(1, len(t)), label="anchor tension [kN]")
+            ax_pipe.set_ylabel("pipe tension [kN]")
+            ax3 = ax_pipe.twinx()
+            ax3.plot(t, ds["pipe_suspended_length"].values, **_style(2, len(t)), label="suspended length [m] (right)")
+            _legend_outside(ax_pipe, ncol=3, handles=ax_pipe.get_lines() + ax3.get_lines())
         elif piped:
             ax_pipe.plot(t, ds["pipe_top_tension"].values / 1e3, **_style(0, len(t)), label="top tension [kN]")
             ax_pipe.plot(t, ds["pipe_horizontal_tension"].values / 1e3, **_style(1, len(t)), label="horizontal tension [kN]")

@@ -264,8 +264,21 @@ class Solution:
                                         f"force of {name}, body frame")
             data[f"moment_{name}"] = var(("time", "axis"), self.account_moment[:, k, :], "N m",
                                          f"moment of {name} about the body origin, body frame")
+        nodes = _pipe_nodes(self.outputs)
         for name, (unit, long_name, values) in self.outputs.items():
-            data[name] = var(("time",), values, unit, long_name)
+            if name not in nodes["names"]:
+                data[name] = var(("time",), values, unit, long_name)
+        if nodes["names"]:
+            # The dynamic pipe's free nodes as two arrays (time, pipe_node, axis), not a variable
+            # per coordinate (docs/model.md §5.18).
+            coords["pipe_node"] = ("pipe_node", np.arange(1, nodes["count"] + 1),
+                                   {"long_name": "the dynamic pipe's free node, from the top"})
+            anchor = _pipe_anchor(self.meta.get("provenance", {}).get("vessel_toml"))
+            extra = {"anchor": anchor} if anchor is not None else {}
+            data["pipe_node_position"] = var(("time", "pipe_node", "axis"), nodes["position"], "m",
+                                             "the dynamic pipe's free nodes' positions, spatial frame (z up)", **extra)
+            data["pipe_node_momentum"] = var(("time", "pipe_node", "axis"), nodes["momentum"], "kg m s-1",
+                                             "the dynamic pipe's free nodes' momenta, spatial frame")
         prov = self.meta.get("provenance", {})
         if "initial_state" in prov:
             y0 = prov["initial_state"]
@@ -312,3 +325,37 @@ class Solution:
         if self.failure:
             ds.attrs["failure"] = self.failure
         return ds
+
+
+def _pipe_nodes(outputs: dict) -> dict:
+    """The dynamic pipe's free-node states among a run's outputs (``pipe_node{i}_{x,y,z}`` and
+    ``pipe_node{i}_p{x,y,z}``), as arrays (time, node, 3), with the names they replace."""
+    import re
+
+    pat = re.compile(r"^pipe_node(\d+)_(p?)([xyz])$")
+    found = {}
+    for name in outputs:
+        m = pat.match(name)
+        if m:
+            found[name] = (int(m.group(1)), m.group(2) == "p", "xyz".index(m.group(3)))
+    if not found:
+        return {"names": set()}
+    n = max(i for i, _, _ in found.values())
+    t = len(next(iter(outputs.values()))[2])
+    pos, mom = np.full((t, n, 3), np.nan), np.full((t, n, 3), np.nan)
+    for name, (i, is_p, a) in found.items():
+        (mom if is_p else pos)[:, i - 1, a] = outputs[name][2]
+    return {"names": set(found), "count": n, "position": pos, "momentum": mom}
+
+
+def _pipe_anchor(vessel_toml) -> list[float] | None:
+    """The dynamic pipe's anchor (m, spatial) from the run's vessel file."""
+    if not vessel_toml:
+        return None
+    try:
+        import tomllib
+
+        p = tomllib.loads(vessel_toml)["pipe"]
+        return [float(p["anchor"][0]), float(p["anchor"][1]), -float(p["water_depth"])]
+    except (KeyError, ValueError, TypeError, IndexError):
+        return None

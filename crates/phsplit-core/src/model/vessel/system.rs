@@ -485,6 +485,11 @@ impl Model for VesselSystem<'_> {
     }
     /// Rate-limited thrusters: record what they deliver at the end of the step.
     fn end_step(&self, t_step: f64, t1: f64, s: &mut VesselState) {
+        for (i, r) in &self.own_flowing {
+            let mut x = s.own[r.clone()].to_vec();
+            self.vessel.forces[*i].own_end_step(s, &mut x);
+            s.own[r.clone()].copy_from_slice(&x);
+        }
         if self.actuators > 0 {
             self.update_memory(s, self.control_on(t_step), |f, fr, z, act| {
                 f.end_step(fr, t1, z, act)

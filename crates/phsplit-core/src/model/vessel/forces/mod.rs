@@ -546,6 +546,10 @@ pub trait Force: Debug + Send + Sync {
     fn own_hull_account(&self) -> Option<usize> {
         None
     }
+    /// Update, at the end of every step, what its own flow holds constant over the next step
+    /// from the body's state `s` and its own states `x` there (where both are synchronised:
+    /// inside a step the sub-flows have moved them by different parts of it).
+    fn own_end_step(&self, _s: &VesselState, _x: &mut [f64]) {}
     /// Set its own states `x` from the body's state `s` where a run starts (the pipe's static
     /// shape under the hang-off point); by default they keep their declared initial values.
     fn init_own(&self, _s: &VesselState, _x: &mut [f64]) -> Result<()> {

@@ -35,7 +35,9 @@
 //! they part by the composition's error, `O(h²)` per unit time and, under a steady pull (a DP
 //! vessel holding against the pipe), steadily. The top is therefore steered back to the
 //! hang-off point over [`DRIFT_RELAXATION`], a velocity `(x + Q r_h − r)/τ` added to its
-//! motion; what the line's pull does on that correction is booked as the supplied account
+//! motion, set at each step's end (where hull and top are synchronised: inside a step they
+//! differ by a first-order amount the sub-flows have not yet made up) and held over the next
+//! (an own state, `pipe_top_return`); what the line's pull does on it is booked as the supplied account
 //! `pipe_hang_off`, `O(h²)` with the drift (docs/model.md §5.18 gives the measured values).
 //! Their distance is reported (`pipe_hang_off_drift`).
 
@@ -77,6 +79,11 @@ const ACCOUNTS: [Account; 7] = [
 
 /// Read `[pipe]` with `model = "lumped_mass"`.
 pub fn build(p: &mut Params, body: &super::super::Body) -> crate::Result<Arc<dyn Force>> {
+    Ok(Arc::new(read(p, body)?))
+}
+
+/// [`build`]'s pipe itself (for a line driven at its top alone: `phsplit.pipe`).
+pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPipe> {
     const T: &str = "pipe";
     let length = p.f64(T, "length", "m", Range::Positive)?;
     let n = p.f64(T, "segments", "an integer", Range::Positive)?;
@@ -176,11 +183,11 @@ pub fn build(p: &mut Params, body: &super::super::Body) -> crate::Result<Arc<dyn
             depth + hang_off.z
         )));
     }
-    Ok(Arc::new(LumpedPipe {
+    Ok(LumpedPipe {
         states: own_states(&chain),
         chain,
         hang_off,
-    }))
+    })
 }
 
 fn own_states(c: &Chain) -> Vec<OwnState> {
@@ -215,6 +222,13 @@ fn own_states(c: &Chain) -> Vec<OwnState> {
                 format!("the pipe's node {i}, momentum {a} (spatial)"),
             ));
         }
+    }
+    for a in ["x", "y", "z"] {
+        v.push(st(
+            format!("pipe_top_return_{a}"),
+            "m s-1",
+            format!("the velocity returning the pipe's top to the hang-off point over the step, {a} (spatial)"),
+        ));
     }
     v
 }
@@ -274,7 +288,7 @@ impl Force for LumpedPipe {
     fn own_flow(
         &self,
         fr: &Frozen,
-        s: &VesselState,
+        _s: &VesselState,
         h: f64,
         x: &mut [f64],
         u: &mut [Vector3<f64>; 2],
@@ -286,8 +300,9 @@ impl Force for LumpedPipe {
         u6.fixed_rows_mut::<3>(0).copy_from(&u[0]);
         u6.fixed_rows_mut::<3>(3).copy_from(&u[1]);
         // The top follows the hang-off point at `B ν`, and returns to it from where the
-        // splitting left it over DRIFT_RELAXATION (`correct`, m/s).
-        let correct = (s.x + s.q * self.hang_off - self.chain.node(x, 0)) / DRIFT_RELAXATION;
+        // splitting left it over DRIFT_RELAXATION (`correct`, m/s, set at the last step's end).
+        let k = self.chain.dim();
+        let correct = Vector3::new(x[k], x[k + 1], x[k + 2]);
         let drift = b * minv * u6 + correct;
         let c = b * minv * b.transpose();
         let Some(w) = self.chain.step(x, h, &Top::Body { drift, c }) else {
@@ -315,9 +330,16 @@ impl Force for LumpedPipe {
         nu: &[Vector3<f64>; 2],
         rates: &mut [f64],
     ) -> [Vector3<f64>; 2] {
-        let top = fr.q * (nu[0] + nu[1].cross(&self.hang_off));
+        let k = self.chain.dim();
+        let top =
+            fr.q * (nu[0] + nu[1].cross(&self.hang_off)) + Vector3::new(x[k], x[k + 1], x[k + 2]);
         let pull = self.chain.rates(x, &top, rates);
         self.wrench(fr, &pull)
+    }
+    fn own_end_step(&self, s: &VesselState, x: &mut [f64]) {
+        let k = self.chain.dim();
+        let c = (s.x + s.q * self.hang_off - self.chain.node(x, 0)) / DRIFT_RELAXATION;
+        x[k..k + 3].copy_from_slice(c.as_slice());
     }
     fn own_hull_account(&self) -> Option<usize> {
         Some(4)
