@@ -80,6 +80,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "x_fore": ("m", REQ, "body x of the fore end, `x_aft < x_fore`"),
     },
     "pipe": {
+        "model": ("-", '"catenary"', "`catenary` (the natural catenary, quasi-static, §5.6) or `lumped_mass` (the dynamic pipe, §5.18, keys below)"),
         "submerged_weight": ("N/m", REQ, "pipe weight in water `w`, > 0 (§5.6)"),
         "water_depth": ("m", REQ, "seabed below the still water line, in (0, 11000]"),
         "hang_off": ("m", REQ, "where the pipe leaves the vessel, body frame, above the seabed"),
@@ -89,6 +90,24 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "touchdown": ("m", "one of four", "`[x, y]` of the touchdown point, spatial"),
         "lay_direction": ("degrees", "required with a tension or an angle", "lay direction, spatial, from x towards y, within ±360"),
         "lay_speed": ("m/s", "0", "with `touchdown`: speed of the touchdown point along `lay_direction`"),
+    },
+    "pipe.lumped_mass": {
+        "model": ("-", REQ, '`"lumped_mass"`: the dynamic pipe (§5.18)'),
+        "length": ("m", REQ, "unstretched length, longer than the hang-off point's height above the seabed"),
+        "segments": ("-", REQ, "number of segments `N`, an integer from 2 to 1000"),
+        "axial_stiffness": ("N", REQ, "axial stiffness `EA`, > 0"),
+        "mass": ("kg/m", REQ, "mass per length in air, more than the displaced water"),
+        "diameter": ("m", REQ, "hydrodynamic outer diameter (over any coating), > 0"),
+        "water_depth": ("m", REQ, "seabed below the still water line, in (0, 11000]"),
+        "hang_off": ("m", REQ, "where the pipe leaves the vessel, body frame, above the seabed"),
+        "anchor": ("m", REQ, "`[x, y]` of the pipe's far end on the seabed, spatial"),
+        "drag_normal": ("-", "1.2", "normal drag coefficient `C_dn` (MoorDyn's default), ≥ 0"),
+        "drag_tangential": ("-", "0.008", "tangential drag coefficient `C_dt` on `π d l`, ≥ 0"),
+        "added_mass": ("-", "1.0", "added-mass coefficient `C_a`, isotropic, ≥ 0"),
+        "seabed_stiffness": ("Pa/m", "3000000.0", "seabed stiffness `k_b` per contact area `d l` (MoorDyn's `kbot`)"),
+        "seabed_damping": ("Pa s/m", "300000.0", "seabed damping `c_b` per contact area (MoorDyn's `cbot`)"),
+        "axial": ("-", '"tension_only"', "`tension_only` (slack segments carry nothing) or `tension_and_compression`"),
+        "axial_damping": ("N s", "0.0", "segments' internal damping `BA` (MoorDyn's), ≥ 0"),
     },
     "spring": {
         "fairlead": ("m", REQ, "the fairlead, body frame, from the body origin, each component within ±1000 m (§5.16)"),
@@ -221,6 +240,7 @@ SOURCE = {
     "damping_quadratic": "`forces/damping_quadratic.rs`",
     "crossflow_drag": "`forces/crossflow.rs`",
     "pipe": "`forces/pipe.rs`",
+    "pipe.lumped_mass": "`forces/pipe/lumped.rs`",
     "spring": "`forces/spring.rs`",
     "port_hamiltonian": "`forces/port_hamiltonian.rs`",
     "setpoint": "`forces/pid.rs`",
@@ -266,6 +286,9 @@ def accepted() -> dict[str, set[str]]:
         d = copy.deepcopy(src)
         d[table]["zz_unknown"] = 0
         out[table] = _probe(lambda: phsplit.Vessel.from_dict(d))
+    d = copy.deepcopy(_lumped())
+    d["pipe"]["zz_unknown"] = 0
+    out["pipe.lumped_mass"] = _probe(lambda: phsplit.Vessel.from_dict(d))
     units = set()
     pipelay = scenario.load("pipelay").vessel.to_dict()
     for kind in ("tunnel", "azimuth", "fixed"):
@@ -299,6 +322,11 @@ def _examples() -> dict[str, dict]:
                 "S": [[0.0]], "N": [[0.0]], "input": ["roll"], "point": [0.0, 0.0, 0.0], "initial": [0.0, 0.0]}}}
 
 
+def _lumped() -> dict:
+    """A valid vessel file with the dynamic pipe (the pipelay-dynamic scenario's)."""
+    return scenario.load("pipelay-dynamic").vessel.to_dict()
+
+
 def _literal(text: str):
     """The value a documented default stands for, when it is one literal (else None)."""
     import tomllib
@@ -314,9 +342,10 @@ def check_defaults() -> list[str]:
     required must be refused when absent, and a literal default must be what the parser fills
     in when the key is left out (where it reports the value back)."""
     problems = []
-    for table, d in _examples().items():
+    cases = [(table, table, d) for table, d in _examples().items()] + [("pipe", "pipe.lumped_mass", _lumped())]
+    for table, doc, d in cases:
         for key in list(d[table]):
-            unit, default, _ = KEYS[table][key]
+            unit, default, _ = KEYS[doc][key]
             e = copy.deepcopy(d)
             del e[table][key]
             try:
@@ -420,13 +449,14 @@ def render() -> str:
         ("Scenario files", ["simulation", "environment.waves", "environment.wind"]),
         ("Vessel files (and any scenario, table by table)",
          ["vessel", "initial", "control", "external", "current", "damping_quadratic", "crossflow_drag",
-          "pipe", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
+          "pipe", "pipe.lumped_mass", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
         ("Sweep files", ["sweep"]),
     ]
     for title, tables in groups:
         parts.append(f"## {title}\n")
         for t in tables:
-            name = "[[thrusters.unit]]" if t == "thrusters.unit" else f"[{t}]"
+            name = ("[[thrusters.unit]]" if t == "thrusters.unit" else
+                    '[pipe]` with `model = "lumped_mass"' if t == "pipe.lumped_mass" else f"[{t}]")
             parts.append(f"### `{name}`\n\nRead by {SOURCE[t]}.\n\n{table_md(t, have)}\n")
     parts.append("## Physical ranges\n\nA length, angle or time beyond what any vessel or sea has is a slip (a unit, a "
                  "digit) and is refused by name, with the range and the reason (`crates/phsplit-core/src/model/vessel/"

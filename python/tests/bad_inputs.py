@@ -1106,3 +1106,37 @@ CATALOGUE += [
     Bad("port-Hamiltonian J with a boolean (Python dict)", _ph_dict(J=[[False, -1.0], [1.0, 0.0]]), E,
         ("port_hamiltonian.J[0][0]", "finite number")),
 ]
+
+
+def _lumped(**keys) -> Callable[[], object]:
+    """The paper's vessel with a dynamic pipe (``keys`` replacing the valid table's own)."""
+    def run():
+        d = phsplit.Vessel.paper().to_dict()
+        d["pipe"] = {"model": "lumped_mass", "length": 600.0, "segments": 30, "axial_stiffness": 3.0e9, "mass": 120.0,
+                     "diameter": 0.3, "water_depth": 200.0, "hang_off": [-40.0, 0.0, -10.0], "anchor": [143.8, -4.0],
+                     **keys}
+        return phsplit.Vessel.from_dict(d)
+    return run
+
+
+CATALOGUE += [
+    Bad("dynamic pipe with one segment", _lumped(segments=1), E, ("pipe.segments", "integer from 2")),
+    Bad("dynamic pipe with a fractional number of segments", _lumped(segments=2.5), E, ("pipe.segments", "integer")),
+    Bad("dynamic pipe with a negative axial stiffness", _lumped(axial_stiffness=-3.0e9), E,
+        ("pipe.axial_stiffness", "> 0", "N")),
+    Bad("dynamic pipe shorter than the depth", _lumped(length=150.0), E, ("pipe.length", "seabed")),
+    Bad("dynamic pipe hung off below the seabed", _lumped(hang_off=[-40.0, 0.0, -250.0]), E,
+        ("pipe.hang_off[2]", "below the seabed")),
+    Bad("dynamic pipe that floats", _lumped(mass=50.0), E, ("pipe.mass", "floats", "displaced water")),
+    Bad("dynamic pipe with its anchor as one number", _lumped(anchor=[1.0]), E, ("pipe.anchor", "2 numbers")),
+    Bad("dynamic pipe that would lie slack on the seabed", _lumped(length=2000.0), E,
+        ("pipe.length", "slack", "anchor")),
+    Bad("pipe of an unknown model", _lumped(model="fem"), E, ("pipe.model", "catenary", "lumped_mass")),
+    Bad("dynamic pipe with a bending stiffness (not modelled)", _lumped(bending_stiffness=1.0e6), E,
+        ("bending_stiffness",)),
+    Bad("dynamic pipe with sp4", lambda: phsplit.simulate(_lumped()(), (0.0, 10.0), 0.5, "sp4"), E,
+        ("Strang", "order 2", "sp2")),
+    Bad("driving a vessel without a dynamic pipe",
+        lambda: phsplit.pipe.drive(phsplit.Vessel.paper(), [0.0, 1.0], [[0.0, 0.0, -10.0], [0.0, 0.0, -10.0]]), E,
+        ("lumped_mass",)),
+]

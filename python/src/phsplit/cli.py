@@ -7,11 +7,18 @@ import sys
 import tempfile
 import time
 
+def _shipped() -> list[str]:
+    from .scenario import shipped
+
+    return shipped()
+
+
 EXAMPLES = """examples:
   phsplit simulate                         # the paper's Fig. 2 scenario (SP4, h = 0.5, [0, 200])
   phsplit simulate scenario.toml --out runs/
   phsplit simulate pipelay                 # a shipped scenario: pipe-lay along a route, thrusters, 1 h
   phsplit simulate dp-weather              # a shipped scenario: station keeping in waves, wind, current, 1 h
+  phsplit simulate pipelay-dynamic         # station keeping in waves over a dynamic (lumped-mass) pipe, 1 h
   phsplit simulate --method sp2 --h 0.25 --t-end 400
   phsplit simulate --control-start never   # the controller off throughout
   phsplit simulate --vessel osv --t-end 600  # Fossen's 83 m offshore supply vessel (MSS osv.m) in DP
@@ -56,7 +63,7 @@ def _parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     s.add_argument("scenario", nargs="?", help="scenario TOML file, or the name of a shipped scenario "
-                   "(pipelay, dp-weather; default: the paper's Fig. 2)")
+                   f"({', '.join(_shipped())}; default: the paper's Fig. 2)")
     s.add_argument("--vessel", help="run the scenario with this vessel: a vessel file, or a shipped "
                    "vessel's name (see 'phsplit vessels')")
     s.add_argument("--out", default="out", help="output folder (default: ./out)")
@@ -404,8 +411,15 @@ def _simulate(args) -> int:
         png = os.path.join(out, f"{name}.png")
         from .chunks import joined
 
-        plot_dp(joined(sols), png)
+        ds_all = joined(sols)
+        plot_dp(ds_all, png)
         files.append(png)
+        if "pipe_node_position" in ds_all:
+            from .plotting import plot_pipe
+
+            pipe_png = os.path.join(out, f"{name}-pipe.png")
+            plot_pipe(ds_all, pipe_png)
+            files.append(pipe_png)
     e = last.euler[-1]
     rr = max(float(s_.ledger.relative_residual().max()) for s_ in sols)
     total = _seconds_since_start()

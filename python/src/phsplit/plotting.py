@@ -317,3 +317,53 @@ def dp_figure(ds, watch_circle: float | None = None, title: str | None = None):
     fig.suptitle(title or f"{ds.attrs.get('method', '').upper()}, h = {ds.attrs.get('step_size_s', '?')} s — "
                  f"{ds.attrs.get('status', '')}, t = {t[0]:g} … {t[-1]:g} s")
     return fig
+
+
+def plot_pipe(ds, path: str, snapshots: int = 8, title: str | None = None) -> None:
+    """The dynamic pipe's figure (docs/model.md §5.18), from a result dataset, written
+    atomically to ``path``: its profile in its vertical plane at ``snapshots`` times and its
+    envelope over the run (horizontal distance from the anchor and height, m), the tensions at
+    its ends and the touchdown's horizontal distance from the anchor over time."""
+    import matplotlib.pyplot as plt
+
+    fig = pipe_figure(ds, snapshots=snapshots, title=title)
+    try:
+        _save(fig, path)
+    finally:
+        plt.close(fig)
+
+
+def pipe_figure(ds, snapshots: int = 8, title: str | None = None):
+    """The figure of :func:`plot_pipe`, not yet written."""
+    import matplotlib.pyplot as plt
+
+    from .pipe import profile
+
+    x, z = profile(ds)
+    t = ds["time"].values
+    fig, (ax_shape, ax_t) = plt.subplots(2, 1, figsize=(10, 8), gridspec_kw={"height_ratios": [3, 2]})
+    idx = np.unique(np.linspace(0, len(t) - 1, max(snapshots, 1)).round().astype(int))
+    for k, i in enumerate(idx):
+        ax_shape.plot(x[i], z[i], color=plt.cm.viridis(k / max(len(idx) - 1, 1)), lw=1.0,
+                      label=f"t = {t[i]:.0f} s")
+    # The envelope: the lowest and highest height of each node over the run.
+    ax_shape.fill_between(np.median(x, axis=0), z.min(axis=0), z.max(axis=0), color="0.7", alpha=0.5,
+                          label="envelope of the nodes")
+    ax_shape.axhline(z[0, -1], color="0.3", lw=0.8)
+    ax_shape.set_xlabel("horizontal distance from the anchor [m]")
+    ax_shape.set_ylabel("height, z up [m]")
+    ax_shape.grid(alpha=0.3)
+    _legend_outside(ax_shape, ncol=min(len(idx) + 1, 5))
+    ax_t.plot(t, ds["pipe_top_tension"].values / 1e3, **_style(0, len(t)), label="top tension [kN]")
+    ax_t.plot(t, ds["pipe_anchor_tension"].values / 1e3, **_style(1, len(t)), label="anchor tension [kN]")
+    ax_t.set_xlabel("t [s]")
+    ax_t.set_ylabel("tension [kN]")
+    ax_t.grid(alpha=0.3)
+    ax2 = ax_t.twinx()
+    a = np.asarray(ds["pipe_node_position"].attrs.get("anchor", [np.nan] * 3), float)
+    td = np.hypot(ds["pipe_touchdown_x"].values - a[0], ds["pipe_touchdown_y"].values - a[1])
+    ax2.plot(t, td, **_style(2, len(t)), label="touchdown from the anchor [m] (right)")
+    _legend_outside(ax_t, ncol=3, handles=ax_t.get_lines() + ax2.get_lines())
+    fig.suptitle(title or "the dynamic pipe: profile, envelope and tensions")
+    fig.tight_layout()
+    return fig

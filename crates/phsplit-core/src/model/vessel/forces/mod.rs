@@ -516,7 +516,7 @@ pub trait Force: Debug + Send + Sync {
     /// advance its own states `x` and the body's momenta `u = (p, m)` (body frame) together, as
     /// a passive system of its own (a discrete gradient: `pipe/chain.rs`), adding to `booked[k]`
     /// the energy of its account `k` (J). The vessel nests it in flow S2 by Strang's rule
-    /// (docs/model.md §3.8). Returns `false` when its solver did not converge.
+    /// (docs/model.md §5.18). Returns `false` when its solver did not converge.
     #[allow(clippy::too_many_arguments)]
     fn own_flow(
         &self,

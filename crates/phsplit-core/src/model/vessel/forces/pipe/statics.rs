@@ -127,7 +127,8 @@ impl Chain {
     /// Structures*, 1981, §1.3), or on the straight line when that is no longer than `L`.
     fn catenary_guess(&self, top: &V3) -> Result<Vec<V3>, String> {
         let n = self.segments;
-        let length = self.length();
+        // The length as given (the segments' sum carries a round-off in its last digit).
+        let length = (self.length() * 1e9).round() / 1e9;
         let ht = top.z - self.seabed;
         let horiz = nalgebra::Vector2::new(self.anchor.x - top.x, self.anchor.y - top.y);
         let span = horiz.norm();
