@@ -1140,3 +1140,11 @@ CATALOGUE += [
         lambda: phsplit.pipe.drive(phsplit.Vessel.paper(), [0.0, 1.0], [[0.0, 0.0, -10.0], [0.0, 0.0, -10.0]]), E,
         ("lumped_mass",)),
 ]
+
+
+CATALOGUE += [
+    Bad("port-Hamiltonian J given as None (Python dict)", _ph_dict(J=None), E,
+        ("port_hamiltonian.J is None", "leave the key out")),
+    Bad("port-Hamiltonian state in a unit CF does not know", _ph_dict(units=["furlongs", "kg m2 s-1"]), E,
+        ("port_hamiltonian.units[0]", "furlongs", "CF unit")),
+]

@@ -48,6 +48,12 @@ pub(crate) fn to_toml(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
                 .collect::<PyResult<_>>()?,
         ));
     }
+    if obj.is_none() {
+        // TOML has no null: a key is given a value or left out.
+        return Err(InvalidInputError::new_err(format!(
+            "{path} is None: give it a value or leave the key out (a file has no null; an optional key left out takes its default)"
+        )));
+    }
     Err(InvalidInputError::new_err(format!(
         "{path} must be a number, a string, a boolean, a sequence or a mapping, got {}",
         obj.get_type().name()?

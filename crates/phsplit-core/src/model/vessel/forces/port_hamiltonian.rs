@@ -242,6 +242,13 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
             units.len()
         )));
     }
+    for (i, u) in units.iter().enumerate() {
+        if !is_cf_unit(u) {
+            return Err(Error::InvalidInput(format!(
+                "{T}.units[{i}] = {u:?} is not a CF unit: a product of SI symbols with integer powers, as UDUNITS writes them (\"kg m2 s-1\", \"rad\", \"N m\", \"1\")"
+            )));
+        }
+    }
     let input = strings(p, "input", "degrees of freedom of the body velocity")?
         .ok_or_else(|| p.missing(T, "input", "a list of degrees of freedom"))?;
     let mut dofs = Vec::new();
@@ -440,6 +447,42 @@ impl Force for PortHamiltonian {
     }
 }
 
+/// Whether `u` is a unit the CF conventions take (CF 1.8 §3.1, UDUNITS-2 syntax), in the form
+/// phsplit writes: `1`, or SI symbols with an optional decimal prefix and an integer power,
+/// separated by spaces or dots (`kg m2 s-1`, `N.m`, `rad s-1`, `degree`).
+fn is_cf_unit(u: &str) -> bool {
+    const SYMBOLS: [&str; 22] = [
+        "m", "s", "g", "kg", "rad", "sr", "N", "J", "W", "Pa", "K", "A", "V", "Hz", "mol", "cd",
+        "C", "ohm", "T", "degree", "bar", "L",
+    ];
+    const PREFIXES: [&str; 8] = ["k", "M", "G", "c", "m", "u", "n", "h"];
+    let known = |sym: &str| {
+        SYMBOLS.contains(&sym)
+            || PREFIXES.iter().any(|p| {
+                sym.len() > p.len() && sym.starts_with(p) && SYMBOLS.contains(&&sym[p.len()..])
+            })
+    };
+    let u = u.trim();
+    if u == "1" {
+        return true;
+    }
+    let tokens: Vec<&str> = u.split([' ', '.']).filter(|t| !t.is_empty()).collect();
+    !tokens.is_empty()
+        && tokens.iter().all(|t| {
+            let cut = t
+                .find(|c: char| c == '-' || c.is_ascii_digit())
+                .unwrap_or(t.len());
+            let (sym, power) = t.split_at(cut);
+            known(sym)
+                && (power.is_empty()
+                    || power
+                        .trim_start_matches('-')
+                        .chars()
+                        .all(|c| c.is_ascii_digit())
+                        && !power.trim_start_matches('-').is_empty())
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use crate::model::vessel::{LinearFlow, Vessel, VesselSystem, PAPER_VESSEL_TOML};
@@ -599,5 +642,26 @@ initial = [0.02, 1.0e4]
         }
         let e = vessel(&TABLE.replace("J = [[0.0, 1.0], [-1.0, 0.0]]\n", "")).unwrap_err();
         assert!(e.to_string().contains("port_hamiltonian.J"), "{e}");
+    }
+
+    #[test]
+    fn units_are_cf_units() {
+        for ok in [
+            "1",
+            "rad",
+            "kg m2 s-1",
+            "N m",
+            "N.m",
+            "m s-2",
+            "degree",
+            "kN",
+            "MJ",
+            "m3",
+        ] {
+            assert!(super::is_cf_unit(ok), "{ok}");
+        }
+        for bad in ["furlongs", "", "m/s", "kg^2", "m-", "1 m x", "metres"] {
+            assert!(!super::is_cf_unit(bad), "{bad}");
+        }
     }
 }
