@@ -69,6 +69,8 @@ bench: $(VENV)/.built $(VENV)/.bench-deps
 	$(BIN)/python benchmarks/weather_stability.py
 	$(BIN)/python benchmarks/general_vessel.py
 	$(BIN)/python benchmarks/fmu_speed.py
+	$(BIN)/python benchmarks/pipe_moordyn.py
+	$(BIN)/python benchmarks/pipe_vs_moordyn.py
 
 bench-quick: $(VENV)/.built $(VENV)/.bench-deps
 	$(BIN)/python benchmarks/work_precision.py --quick --out benchmarks/results-quick

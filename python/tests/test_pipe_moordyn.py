@@ -12,9 +12,10 @@ N = 50 (its smallest dtM) gives the mean and the first harmonic at the forcing p
 segment's tension (GetLineFairTen) over t in [50, 100] s, and in the taut case (max - min)/2.
 
 phsplit's ``pipe.drive`` at N = 50 must match them within 5 %: the taut case at h = 20 ms
-(converged: halving changes mean and first harmonic by < 0.1 %), the slack case at h = 0.625 ms
-(the snap loads need the axial waves resolved; its halving changes mean and first harmonic by
-< 0.2 %, benchmarks/results/pipe/comparison.md; the 0.1 % step, 0.3125 ms, takes ~30 s).
+(converged: halving changes mean and first harmonic by < 0.01 %), the slack case at
+h = 0.625 ms (the snap loads need the axial waves resolved; its halving changes mean and first
+harmonic by 0.17 % and 0.16 %, and further halvings keep wandering by 0.1-0.3 %, as MoorDyn's
+do: benchmarks/results/pipe/comparison.md, written by benchmarks/pipe_vs_moordyn.py).
 The statistics are those of pipe_moordyn.py (trapezoidal Fourier integrals over the samples).
 """
 from __future__ import annotations
