@@ -82,16 +82,10 @@ mod statics;
 /// dynamic lumped-mass line (`pipe/lumped.rs`).
 pub const MODELS: [&str; 2] = ["catenary", "lumped_mass"];
 
-pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+/// `pipe.water_depth` (m) and `pipe.hang_off` (m, body frame), checked: the hang-off point
+/// within [`MAX_ARM`] of the body origin and above the seabed. Both models read them so.
+fn depth_and_hang_off(p: &mut Params) -> crate::Result<(f64, Vector3<f64>)> {
     const T: &str = "pipe";
-    p.declare(T);
-    if !p.has(T) {
-        return Ok(None);
-    }
-    if p.choice(T, "model", &MODELS)? == "lumped_mass" {
-        return lumped::build(p, body).map(Some);
-    }
-    let weight = p.f64(T, "submerged_weight", "N/m", Range::Positive)?;
     let water_depth = p.f64(
         T,
         "water_depth",
@@ -114,6 +108,20 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
             hang_off.z
         )));
     }
+    Ok((water_depth, hang_off))
+}
+
+pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
+    const T: &str = "pipe";
+    p.declare(T);
+    if !p.has(T) {
+        return Ok(None);
+    }
+    if p.choice(T, "model", &MODELS)? == "lumped_mass" {
+        return lumped::build(p, body).map(Some);
+    }
+    let weight = p.f64(T, "submerged_weight", "N/m", Range::Positive)?;
+    let (water_depth, hang_off) = depth_and_hang_off(p)?;
     let h = p.opt_f64(T, "horizontal_tension", "N", Range::Positive)?;
     let top = p.opt_f64(T, "top_tension", "N", Range::Positive)?;
     let angle = p.opt_f64(

@@ -46,7 +46,7 @@ use super::chain::{Chain, Top};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::lie::so3;
-use crate::model::vessel::params::{physical, Params, Range};
+use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
 use crate::solve::Account;
 use nalgebra::{Matrix3, SMatrix, Vector3};
@@ -96,23 +96,7 @@ pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPi
     let ea = p.f64(T, "axial_stiffness", "N", Range::Positive)?;
     let mass = p.f64(T, "mass", "kg/m", Range::Positive)?;
     let d = p.f64(T, "diameter", "m", Range::Positive)?;
-    let depth = p.f64(
-        T,
-        "water_depth",
-        "m",
-        Range::Physical(&physical::WATER_DEPTH),
-    )?;
-    let hang_off: Vector3<f64> = p
-        .vec3(T, "hang_off", None, "m, body frame", Range::Finite)?
-        .into();
-    for (i, r) in hang_off.iter().enumerate() {
-        if r.abs() > super::MAX_ARM {
-            return Err(Error::InvalidInput(format!(
-                "pipe.hang_off[{i}] must lie within {} m of the body origin (m, body frame), got {r}",
-                super::MAX_ARM
-            )));
-        }
-    }
+    let (depth, hang_off) = super::depth_and_hang_off(p)?;
     let anchor = p
         .rows(T, "anchor", 1, "m, spatial x and y", Range::Finite)?
         .ok_or_else(|| p.missing(T, "anchor", "[x, y], m, spatial"))?;
@@ -171,12 +155,6 @@ pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPi
         anchor: Vector3::new(anchor[0], anchor[1], -depth),
         current,
     };
-    if depth + hang_off.z <= 0.0 {
-        return Err(Error::InvalidInput(format!(
-            "pipe.hang_off[2] = {} m puts the hang-off point at or below the seabed (pipe.water_depth = {depth} m); it must lie above it",
-            hang_off.z
-        )));
-    }
     if length <= depth + hang_off.z {
         return Err(Error::InvalidInput(format!(
             "pipe.length = {length} m is not longer than the height of the hang-off point above the seabed ({} m, pipe.water_depth + pipe.hang_off[2]): the pipe cannot reach the seabed",
