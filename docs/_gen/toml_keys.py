@@ -108,6 +108,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "seabed_damping": ("Pa s/m", "300000.0", "seabed damping `c_b` per contact area (MoorDyn's `cbot`)"),
         "axial": ("-", '"tension_only"', "`tension_only` (slack segments carry nothing) or `tension_and_compression`"),
         "axial_damping": ("N s", "0.0", "segments' internal damping `BA` (MoorDyn's), ≥ 0"),
+        "bending_stiffness": ("N m²", "0.0", "bending stiffness `EI`: a rotational spring `(EI/l)(1 − cos θ)` at each free node, ≥ 0"),
     },
     "spring": {
         "fairlead": ("m", REQ, "the fairlead, body frame, from the body origin, each component within ±1000 m (§5.16)"),

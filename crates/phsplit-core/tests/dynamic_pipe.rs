@@ -110,7 +110,7 @@ fn bad_pipe_tables_name_the_key() {
         ("anchor = [1.0]", "pipe.anchor"),
         ("drag_normal = -1.0", "pipe.drag_normal"),
         ("axial = \"elastic\"", "pipe.axial"),
-        ("bending_stiffness = 1e6", "bending_stiffness"),
+        ("bending_stiffness = -1e6", "pipe.bending_stiffness"),
     ];
     for (line, key) in cases {
         let base = format!(

@@ -48,6 +48,9 @@ pub struct Chain {
     pub weight: f64,
     /// Axial (internal) damping per segment, `BA/l` (N s/m): MoorDyn's `BA`.
     pub axial_damping: f64,
+    /// Bending stiffness `EI` (N m²): a rotational spring `(EI/l)(1 − cos θ)` at each free node,
+    /// `θ` the turn between its segments (0: none).
+    pub bending: f64,
     /// Drag factors `½ ρ C_dn d l` and `½ ρ C_dt π d l` (kg/m).
     pub drag_normal: f64,
     pub drag_tangential: f64,
@@ -263,6 +266,91 @@ impl Chain {
         }
     }
 
+    /// The bending spring's energy at a free node between its neighbours `a` and `c`.
+    fn bend(&self, a: &V3, b: &V3, c: &V3) -> f64 {
+        let (u, v) = (b - a, c - b);
+        let (nu, nv) = (u.norm(), v.norm());
+        if nu == 0.0 || nv == 0.0 {
+            return 0.0;
+        }
+        self.bending / self.rest * (1.0 - u.dot(&v) / (nu * nv))
+    }
+    /// Its gradient in `(a, b, c)`.
+    fn bend_gradient(&self, a: &V3, b: &V3, c: &V3) -> [V3; 3] {
+        let (u, v) = (b - a, c - b);
+        let (nu, nv) = (u.norm(), v.norm());
+        if nu == 0.0 || nv == 0.0 {
+            return [V3::zeros(); 3];
+        }
+        let k = self.bending / self.rest;
+        let cos = u.dot(&v) / (nu * nv);
+        let du = v / (nu * nv) - u * (cos / (nu * nu));
+        let dv = u / (nu * nv) - v * (cos / (nv * nv));
+        // V = k (1 − cos θ), u = b − a, v = c − b.
+        [du * k, (dv - du) * k, -dv * k]
+    }
+    /// Gonzalez's discrete gradient of the bending spring at node `i` between the positions
+    /// `p0` and `p1` (its three nodes' nine coordinates: `∇V(ȳ)` and the correction along
+    /// `Δy` that makes it exact), and the blocks `(EI/l³) P ⊗ [1, −2, 1]ᵀ[1, −2, 1]` (`P` the
+    /// projector across the line) that stand for its Hessian in Newton's method, scaled by
+    /// `scale`.
+    fn bend_dg(&self, p0: &[V3], p1: &[V3], i: usize, scale: f64) -> ([V3; 3], [[M3; 3]; 3]) {
+        let mid: [V3; 3] = std::array::from_fn(|k| 0.5 * (p0[i - 1 + k] + p1[i - 1 + k]));
+        let mut g = self.bend_gradient(&mid[0], &mid[1], &mid[2]);
+        let d: [V3; 3] = std::array::from_fn(|k| p1[i - 1 + k] - p0[i - 1 + k]);
+        let dd: f64 = d.iter().map(|x| x.norm_squared()).sum();
+        if dd > 0.0 {
+            let dv = self.bend(&p1[i - 1], &p1[i], &p1[i + 1])
+                - self.bend(&p0[i - 1], &p0[i], &p0[i + 1]);
+            let lin: f64 = (0..3).map(|k| g[k].dot(&d[k])).sum();
+            let c = (dv - lin) / dd;
+            for k in 0..3 {
+                g[k] += d[k] * c;
+            }
+        }
+        let t = Self::tangent(&mid[0], &mid[2]);
+        let p = (M3::identity() - t * t.transpose()) * (scale * self.bending / self.rest.powi(3));
+        let w = [1.0, -2.0, 1.0];
+        (
+            g,
+            std::array::from_fn(|r| std::array::from_fn(|c| p * (w[r] * w[c]))),
+        )
+    }
+    /// Add the bending springs' discrete gradients (forces `−∇̄V`) and Hessian blocks (scaled by
+    /// `scale`) to the residual's parts: `off` the blocks `(k, k + 1)`, `far` `(k, k + 2)`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn add_bending(
+        &self,
+        p0: &[V3],
+        p1: &[V3],
+        scale: f64,
+        f: &mut [V3],
+        diag: &mut [M3],
+        off: &mut [M3],
+        far: &mut [M3],
+    ) {
+        if self.bending <= 0.0 {
+            return;
+        }
+        let n = self.segments;
+        for i in 1..n {
+            let (g, hb) = self.bend_dg(p0, p1, i, scale);
+            for k in 0..3 {
+                let a = i - 1 + k;
+                if a < n {
+                    f[a] -= g[k];
+                    diag[a] += hb[k][k];
+                }
+            }
+            // Node i + 1 is the anchor (no unknown) when i = N − 1.
+            off[i - 1] += hb[0][1];
+            if i + 1 < n {
+                off[i] += hb[1][2];
+                far[i - 1] += hb[0][2];
+            }
+        }
+    }
+
     /// The energy the line stores (J): kinetic, the segments' strain, the weight (from `z = 0`)
     /// and the seabed's springs.
     pub fn storage(&self, x: &[f64]) -> f64 {
@@ -275,6 +363,9 @@ impl Chain {
         }
         for j in 0..self.segments {
             e += self.psi((self.node(x, j + 1) - self.node(x, j)).norm());
+        }
+        for i in 1..self.segments {
+            e += self.bend(&self.node(x, i - 1), &self.node(x, i), &self.node(x, i + 1));
         }
         // The top half segment's weight, carried at the top.
         e + 0.5 * self.weight * self.node(x, 0).z
@@ -324,14 +415,16 @@ impl Chain {
         f: &mut [V3],
         diag: &mut [M3],
         off: &mut [M3],
+        far: &mut [M3],
     ) -> (f64, f64, f64, f64) {
         let n = self.segments;
         for v in f.iter_mut() {
             *v = V3::zeros();
         }
-        for m in diag.iter_mut().chain(off.iter_mut()) {
+        for m in diag.iter_mut().chain(off.iter_mut()).chain(far.iter_mut()) {
             *m = M3::zeros();
         }
+        self.add_bending(p0, p1, 0.5, f, diag, off, far);
         let mut axial = 0.0;
         for j in 0..n {
             let (d0, d1) = (p0[j + 1] - p0[j], p1[j + 1] - p1[j]);
@@ -414,16 +507,22 @@ impl Chain {
             Top::Given(_) => None,
         };
         let inertia = 2.0 * self.mass / (h * h);
-        let (mut f, mut diag, mut off) = (
+        let (mut f, mut diag, mut off, mut far) = (
             vec![V3::zeros(); n],
+            vec![M3::zeros(); n],
             vec![M3::zeros(); n],
             vec![M3::zeros(); n],
         );
         let mut g = vec![V3::zeros(); n];
         let scale = self.length() + p0[0].norm() + self.anchor.norm();
         // The residual (force units) and its Jacobian at `p1`; its norm.
-        let residual = |p1: &[V3], f: &mut [V3], diag: &mut [M3], off: &mut [M3], g: &mut [V3]| {
-            self.forces(&p0, p1, h, f, diag, off);
+        let residual = |p1: &[V3],
+                        f: &mut [V3],
+                        diag: &mut [M3],
+                        off: &mut [M3],
+                        far: &mut [M3],
+                        g: &mut [V3]| {
+            self.forces(&p0, p1, h, f, diag, off, far);
             for i in 1..n {
                 g[i] = (p1[i] - p0[i]) * inertia - mom[i] * (2.0 / h) - f[i];
                 diag[i] += M3::identity() * inertia;
@@ -437,15 +536,16 @@ impl Chain {
                     g[0] = V3::zeros();
                     diag[0] = M3::identity();
                     off[0] = M3::zeros();
+                    far[0] = M3::zeros();
                 }
             }
             g.iter().map(|v| v.norm_squared()).sum::<f64>().sqrt()
         };
-        let mut norm = residual(&p1, &mut f, &mut diag, &mut off, &mut g);
+        let mut norm = residual(&p1, &mut f, &mut diag, &mut off, &mut far, &mut g);
         let mut converged = false;
         let mut trial = p1.clone();
         for _ in 0..MAX_NEWTON {
-            let delta = solve_tridiagonal(&diag, &off, &g)?;
+            let delta = solve_banded(&diag, &off, &far, &g)?;
             // Newton's step, halved while it does not lower the residual (a node crossing the
             // seabed or a segment going slack is a kink of the forces, where full steps can
             // cycle).
@@ -454,7 +554,7 @@ impl Chain {
                 for i in 0..n {
                     trial[i] = p1[i] - delta[i] * lambda;
                 }
-                let r = residual(&trial, &mut f, &mut diag, &mut off, &mut g);
+                let r = residual(&trial, &mut f, &mut diag, &mut off, &mut far, &mut g);
                 if r < norm || lambda < 1.0 / 1024.0 || !r.is_finite() {
                     norm = r;
                     break;
@@ -474,7 +574,8 @@ impl Chain {
         if !converged {
             return None;
         }
-        let (drag, bed, cur, axial) = self.forces(&p0, &p1, h, &mut f, &mut diag, &mut off);
+        let (drag, bed, cur, axial) =
+            self.forces(&p0, &p1, h, &mut f, &mut diag, &mut off, &mut far);
         let pull = f[0];
         for i in 0..n {
             x[3 * i..3 * i + 3].copy_from_slice(p1[i].as_slice());
@@ -517,6 +618,12 @@ impl Chain {
             f[j] += pull;
             f[j + 1] -= pull;
         }
+        for i in 1..n {
+            let g = self.bend_gradient(&p[i - 1], &p[i], &p[i + 1]);
+            for k in 0..3 {
+                f[i - 1 + k] -= g[k];
+            }
+        }
         f[0].z -= 0.5 * self.weight;
         rates[..3].copy_from_slice(top_velocity.as_slice());
         let base = 3 + 3 * self.free();
@@ -534,27 +641,53 @@ impl Chain {
     }
 }
 
-/// Solve the block-tridiagonal system with diagonal blocks `d`, off-diagonal blocks `o` (`o[k]`
-/// is both block `(k, k + 1)` and block `(k + 1, k)`: a segment's `−K` in the rows of both its
-/// ends) and right-hand side `g`, by block elimination; `None` if a pivot block is singular.
-pub(super) fn solve_tridiagonal(d: &[M3], o: &[M3], g: &[V3]) -> Option<Vec<V3>> {
+/// Solve the block-banded system with diagonal blocks `d`, off-diagonal blocks `o` (`o[k]` is
+/// both block `(k, k + 1)` and block `(k + 1, k)`: a segment's `−K` in the rows of both its
+/// ends) and `far` (`far[k]` both `(k, k + 2)` and `(k + 2, k)`: a bending spring's), and
+/// right-hand side `g`, by block Gaussian elimination in the band; `None` if a pivot block is
+/// singular.
+pub(super) fn solve_banded(d: &[M3], o: &[M3], far: &[M3], g: &[V3]) -> Option<Vec<V3>> {
     let n = d.len();
-    let mut dp = vec![M3::zeros(); n];
-    let mut gp = vec![V3::zeros(); n];
+    // Row k's blocks at columns k − 2 … k + 2.
+    let mut a: Vec<[M3; 5]> = (0..n)
+        .map(|k| {
+            let get = |j: isize| -> M3 {
+                let j = k as isize + j;
+                if j < 0 || j >= n as isize {
+                    return M3::zeros();
+                }
+                let (lo, dist) = ((j as usize).min(k), (j - k as isize).unsigned_abs());
+                match dist {
+                    0 => d[k],
+                    1 => o[lo],
+                    _ => far[lo],
+                }
+            };
+            [get(-2), get(-1), get(0), get(1), get(2)]
+        })
+        .collect();
+    let mut b = g.to_vec();
     let mut inv = vec![M3::zeros(); n];
-    dp[0] = d[0];
-    gp[0] = g[0];
-    inv[0] = dp[0].try_inverse()?;
-    for k in 1..n {
-        let l = o[k - 1] * inv[k - 1];
-        dp[k] = d[k] - l * o[k - 1];
-        gp[k] = g[k] - l * gp[k - 1];
-        inv[k] = dp[k].try_inverse()?;
+    for k in 0..n {
+        inv[k] = a[k][2].try_inverse()?;
+        for r in k + 1..(k + 3).min(n) {
+            // Column k sits at 2 + k − r in row r.
+            let l = a[r][2 + k - r] * inv[k];
+            for c in k + 1..(k + 3).min(n) {
+                let upper = a[k][2 + c - k];
+                a[r][2 + c - r] -= l * upper;
+            }
+            let bk = b[k];
+            b[r] -= l * bk;
+        }
     }
     let mut x = vec![V3::zeros(); n];
-    x[n - 1] = inv[n - 1] * gp[n - 1];
-    for k in (0..n - 1).rev() {
-        x[k] = inv[k] * (gp[k] - o[k] * x[k + 1]);
+    for k in (0..n).rev() {
+        let mut r = b[k];
+        for c in k + 1..(k + 3).min(n) {
+            r -= a[k][2 + c - k] * x[c];
+        }
+        x[k] = inv[k] * r;
     }
     Some(x)
 }
@@ -575,6 +708,7 @@ mod tests {
             ea,
             compression: false,
             axial_damping: 0.0,
+            bending: 0.0,
             mass: (mu + rho * area) * l,
             weight: (mu - rho * area) * g * l,
             drag_normal: 0.5 * rho * 1.2 * d * l,
@@ -668,6 +802,8 @@ mod tests {
     fn a_step_books_the_line_energy_exactly() {
         let mut c = line(40, 3e9);
         c.axial_damping = 1e6 / c.rest;
+        // A 12-inch steel pipe's EI (207 GPa, 323.9 by 15.9 mm).
+        c.bending = 3.8e7;
         c.current = V3::new(0.5, -0.3, 0.0);
         let nodes = c.static_shape(&TOP).unwrap();
         let mut x = vec![0.0; c.dim()];
@@ -707,6 +843,31 @@ mod tests {
                     e1 - e0
                 );
                 assert!(w.drag >= 0.0 && w.axial >= 0.0 && w.seabed >= 0.0);
+            }
+        }
+    }
+    /// The bending spring's gradient is its energy's, by central differences.
+    #[test]
+    fn the_bending_springs_gradient_is_its_energys() {
+        let mut c = line(10, 3e9);
+        c.bending = 3.8e7;
+        let pts = [
+            V3::new(0.0, 0.0, 0.0),
+            V3::new(10.0, 1.0, -2.0),
+            V3::new(19.0, 3.0, -6.0),
+        ];
+        let g = c.bend_gradient(&pts[0], &pts[1], &pts[2]);
+        for k in 0..3 {
+            for j in 0..3 {
+                let (mut p, mut m) = (pts, pts);
+                p[k][j] += 1e-6;
+                m[k][j] -= 1e-6;
+                let fd = (c.bend(&p[0], &p[1], &p[2]) - c.bend(&m[0], &m[1], &m[2])) / 2e-6;
+                assert!(
+                    (g[k][j] - fd).abs() < 1e-6 * g[k].norm(),
+                    "{k} {j}: {} vs {fd}",
+                    g[k][j]
+                );
             }
         }
     }

@@ -120,6 +120,7 @@ pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPi
     let cb = opt(p, "seabed_damping", "Pa s/m", 3.0e5)?;
     let axial = p.choice(T, "axial", &["tension_only", "tension_and_compression"])?;
     let ba = opt(p, "axial_damping", "N s", 0.0)?;
+    let ei = opt(p, "bending_stiffness", "N m^2", 0.0)?;
     let g = p.f64("vessel", "gravity", "m/s^2", Range::Positive)?;
     let rho = p.f64("vessel", "water_density", "kg/m^3", Range::Positive)?;
     let area = std::f64::consts::PI * d * d / 4.0;
@@ -145,6 +146,7 @@ pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPi
         ea,
         compression: axial == "tension_and_compression",
         axial_damping: ba / l,
+        bending: ei,
         mass: (mass + ca * rho * area) * l,
         weight: (mass - rho * area) * g * l,
         drag_normal: 0.5 * rho * cdn * d * l,
@@ -387,6 +389,12 @@ impl Force for LumpedPipe {
             "m-1",
             "the pipe's largest curvature (the sagbend's; turn per length between segments)",
             kappa,
+        ));
+        out.push(Output::new(
+            "pipe_max_bending_moment",
+            "N m",
+            "the pipe's largest bending moment, EI times its largest curvature (0 without pipe.bending_stiffness)",
+            c.bending * kappa,
         ));
         let hang = fr.origin + z[0][1] + fr.q * self.hang_off;
         out.push(Output::new(

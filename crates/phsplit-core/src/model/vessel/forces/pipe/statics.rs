@@ -2,7 +2,7 @@
 //! equilibrium of its weight, its segments and the seabed, directly (no dynamic relaxation), from
 //! the natural catenary with seabed contact.
 
-use super::chain::{solve_tridiagonal, Chain};
+use super::chain::{solve_banded, Chain};
 use nalgebra::{Matrix3, Vector3};
 
 type V3 = Vector3<f64>;
@@ -23,6 +23,8 @@ impl Chain {
         let mut soft = self.clone();
         soft.ea = self.ea.min(100.0 * scale.max(f64::MIN_POSITIVE));
         loop {
+            // The bending stiffness in proportion: the line's shape changes smoothly along.
+            soft.bending = self.bending * soft.ea / self.ea;
             p = soft.static_from(p)?;
             if soft.ea >= self.ea {
                 return Ok(p[1..self.segments].to_vec());
@@ -36,19 +38,21 @@ impl Chain {
         let n = self.segments;
         let top = p[0];
         let scale = self.length() + top.norm() + self.anchor.norm();
-        let (mut f, mut diag, mut off) = (
+        let (mut f, mut diag, mut off, mut far) = (
             vec![V3::zeros(); n],
+            vec![M3::zeros(); n],
             vec![M3::zeros(); n],
             vec![M3::zeros(); n],
         );
         let mut g = vec![V3::zeros(); n];
-        let residual = |s: &Self, p: &[V3], f: &mut [V3], d: &mut [M3], o: &mut [M3]| {
-            // The static forces: the discrete gradient at coinciding ends is the gradient, and
-            // its derivative in one end half the stiffness; no drag (a huge h).
-            s.static_forces(p, f, d, o);
-            (1..n).map(|i| f[i].norm_squared()).sum::<f64>().sqrt()
-        };
-        let mut norm = residual(self, &p, &mut f, &mut diag, &mut off);
+        let residual =
+            |s: &Self, p: &[V3], f: &mut [V3], d: &mut [M3], o: &mut [M3], fa: &mut [M3]| {
+                // The static forces: the discrete gradient at coinciding ends is the gradient, and
+                // its derivative in one end half the stiffness; no drag (a huge h).
+                s.static_forces(p, f, d, o, fa);
+                (1..n).map(|i| f[i].norm_squared()).sum::<f64>().sqrt()
+            };
+        let mut norm = residual(self, &p, &mut f, &mut diag, &mut off, &mut far);
         for _ in 0..200 {
             for i in 1..n {
                 g[i] = -f[i];
@@ -56,13 +60,14 @@ impl Chain {
             g[0] = V3::zeros();
             diag[0] = M3::identity();
             off[0] = M3::zeros();
+            far[0] = M3::zeros();
             // A little transverse stiffness for slack segments (their tangent stiffness is 0):
             // it only changes Newton's path, not the equilibrium.
             let eps = 1e-9 * self.ea / self.rest;
             for d in diag.iter_mut().skip(1) {
                 *d += M3::identity() * eps;
             }
-            let delta = solve_tridiagonal(&diag, &off, &g)
+            let delta = solve_banded(&diag, &off, &far, &g)
                 .ok_or("the static pipe's Newton system is singular")?;
             let mut lambda = 1.0;
             let mut trial = p.clone();
@@ -70,7 +75,7 @@ impl Chain {
                 for i in 1..n {
                     trial[i] = p[i] - delta[i] * lambda;
                 }
-                let r = residual(self, &trial, &mut f, &mut diag, &mut off);
+                let r = residual(self, &trial, &mut f, &mut diag, &mut off, &mut far);
                 if r < norm || lambda < 1e-6 {
                     norm = r;
                     break;
@@ -88,7 +93,14 @@ impl Chain {
         ))
     }
 
-    fn static_forces(&self, p: &[V3], f: &mut [V3], diag: &mut [M3], off: &mut [M3]) {
+    fn static_forces(
+        &self,
+        p: &[V3],
+        f: &mut [V3],
+        diag: &mut [M3],
+        off: &mut [M3],
+        far: &mut [M3],
+    ) {
         let n = self.segments;
         let mut full: Vec<V3> = p.to_vec();
         full.truncate(n);
@@ -96,9 +108,11 @@ impl Chain {
         for v in f.iter_mut() {
             *v = V3::zeros();
         }
-        for m in diag.iter_mut().chain(off.iter_mut()) {
+        for m in diag.iter_mut().chain(off.iter_mut()).chain(far.iter_mut()) {
             *m = M3::zeros();
         }
+        // The bending springs at coinciding ends: their gradient, and the Hessian's stand-in.
+        self.add_bending(&full, &full, 1.0, f, diag, off, far);
         for j in 0..n {
             let d = full[j + 1] - full[j];
             let (pull, k) = self.segment(&d, &d);
