@@ -74,6 +74,7 @@ pub struct PipeState {
 /// Largest distance of the hang-off point from the body origin (m).
 pub const MAX_ARM: f64 = 1000.0;
 
+mod bending;
 pub mod chain;
 pub mod lumped;
 mod statics;

@@ -2,7 +2,8 @@
 //! equilibrium of its weight, its segments and the seabed, directly (no dynamic relaxation), from
 //! the natural catenary with seabed contact.
 
-use super::chain::{solve_banded, Chain};
+use super::bending::solve_banded;
+use super::chain::Chain;
 use nalgebra::{Matrix3, Vector3};
 
 type V3 = Vector3<f64>;
