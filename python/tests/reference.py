@@ -377,6 +377,24 @@ class Field:
         return h
 
 
+def full_initial(params: dict, y0) -> np.ndarray:
+    """The whole initial state of ``y0`` (the 27 numbers, or the 27 then the subsystem's states):
+    then the set point's filter at rest on the first set point, the subsystem at its ``initial``."""
+    y = np.array(y0, dtype=float)
+    ph = params.get("port_hamiltonian")
+    nc = len(ph["states"]) if ph else 0
+    own = np.array(ph.get("initial", [0.0] * nc), float) if nc else None
+    if nc and len(y) == 27 + nc:
+        y, own = y[:27], y[27:]
+    if "setpoint" in params and len(y) == 27:
+        # the filter starts at rest on the first set point
+        r0, _ = Field(params, True).r_of(params["setpoint"].get("start_time", 0.0))
+        y = np.concatenate([y, r0, np.zeros(12)])
+    if nc and len(y) in (27, 45):
+        y = np.concatenate([y, own])
+    return y
+
+
 def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | None, t_eval=None,
           rtol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
     """Reference solution on [0, t_end]: DOP853 with rtol 1e-13, split at the controller switch.
@@ -392,19 +410,7 @@ def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | Non
         segments.append((max(cs, 0.0), t_end, True))
     t_eval = np.asarray(t_eval) if t_eval is not None else np.array([t_end])
     ts, ys = [], []
-    y = np.array(y0, dtype=float)
-    ph = params.get("port_hamiltonian")
-    nc = len(ph["states"]) if ph else 0
-    own = np.array(ph.get("initial", [0.0] * nc), float) if nc else None
-    if nc and len(y) == 27 + nc:
-        y, own = y[:27], y[27:]
-    if "setpoint" in params and len(y) == 27:
-        # the filter starts at rest on the first set point
-        f0 = Field(params, True)
-        r0, _ = f0.r_of(params["setpoint"].get("start_time", 0.0))
-        y = np.concatenate([y, r0, np.zeros(12)])
-    if nc and len(y) in (27, 45):
-        y = np.concatenate([y, own])
+    y = full_initial(params, y0)
     atol = np.maximum(np.abs(y), 1.0) * rtol * 1e-3
     for a, b, on in segments:
         f = Field(params, on)

@@ -65,7 +65,7 @@ Checks made when this was written (the paper's vessel, the line below with r_h =
 from __future__ import annotations
 
 import numpy as np
-from reference import Field
+from reference import Field, full_initial
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.sparse import csc_matrix, lil_matrix
@@ -498,21 +498,8 @@ class CoupledField:
 
 
 def _vessel_y0(vessel_params: dict, y0) -> np.ndarray:
-    """The vessel's full initial state as reference.py's solve builds it (the set point's filter
-    at rest on the first set point, the subsystem at its ``initial``)."""
-    y = np.array(y0, dtype=float)
-    vp = _vessel_only(vessel_params)
-    ph = vp.get("port_hamiltonian")
-    nc = len(ph["states"]) if ph else 0
-    own = np.array(ph.get("initial", [0.0] * nc), float) if nc else None
-    if nc and len(y) == 27 + nc:
-        y, own = y[:27], y[27:]
-    if "setpoint" in vp and len(y) == 27:
-        r0, _ = Field(vp, True).r_of(vp["setpoint"].get("start_time", 0.0))
-        y = np.concatenate([y, r0, np.zeros(12)])
-    if nc and len(y) in (27, 45):
-        y = np.concatenate([y, own])
-    return y
+    """The vessel's full initial state as reference.py's solve builds it."""
+    return full_initial(_vessel_only(vessel_params), y0)
 
 
 def initial_pipe(vessel_params: dict, pipe: dict | None, y0_vessel, **kw) -> np.ndarray:

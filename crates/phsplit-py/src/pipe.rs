@@ -69,7 +69,7 @@ fn drive_pipe<'py>(
     let mut storage = vec![0.0; n];
     let mut books: [Vec<f64>; 5] = std::array::from_fn(|_| vec![0.0; n]);
     let record = |i: usize, x: &[f64], seg: &mut [f64], at_top: &mut [f64], st: &mut [f64]| {
-        seg[i] = pipe.tensions(x)[0];
+        seg[i] = c.tension((c.node(x, 1) - c.node(x, 0)).norm());
         at_top[i] = c.top_force(x).norm();
         st[i] = c.storage(x);
     };

@@ -7,6 +7,15 @@ import sys
 import tempfile
 import time
 
+def _writable_ancestor(path: str) -> tuple[str, bool]:
+    """The nearest existing folder of ``path`` (itself if it exists) and whether a file or
+    folder can be made in it: what an output that is not yet there needs."""
+    parent = path
+    while not os.path.exists(parent):
+        parent = os.path.dirname(os.path.abspath(parent))
+    return parent, os.path.isdir(parent) and os.access(parent, os.W_OK | os.X_OK)
+
+
 def _shipped() -> list[str]:
     from .scenario import shipped
 
@@ -537,10 +546,8 @@ def _sweep(args) -> int:
     store = args.out or os.path.splitext(args.sweep)[0] + ".store"
     if os.path.exists(store) and not os.path.isdir(store):
         raise UsageError(f"the store {store!r} is a file, not a folder (--out names a folder)")
-    parent = store
-    while not os.path.exists(parent):
-        parent = os.path.dirname(os.path.abspath(parent))
-    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+    parent, ok = _writable_ancestor(store)
+    if not ok:
         raise UsageError(f"cannot create the store {store!r}: {parent!r} is not a writable folder")
     print(f"sweep {sw.name}: {len(sw.cases)} cases, {sw.settings.method} h={sw.settings.h:g} s on "
           f"[{sw.settings.t_span[0]:g}, {sw.settings.t_span[1]:g}] s; store {os.path.abspath(store)}", flush=True)
@@ -573,10 +580,8 @@ def _rerun(args) -> int:
             raise UsageError(f"cannot write the rerun to {dest!r}: a folder of that name is in the way")
         if os.path.exists(dest) and os.path.samefile(dest, args.file):
             raise UsageError(f"--out {args.out!r} would overwrite {args.file!r} with its rerun; choose another folder")
-        parent = args.out
-        while not os.path.exists(parent):
-            parent = os.path.dirname(os.path.abspath(parent))
-        if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+        parent, ok = _writable_ancestor(args.out)
+        if not ok:
             raise UsageError(f"cannot create --out {args.out!r}: {parent!r} is not a writable folder")
     ds = open_dataset(args.file)
     if "case" in ds.dims:
@@ -709,10 +714,8 @@ def _capability(args) -> int:
     # itself is made only once there is something to write into it.
     if os.path.exists(out) and not os.path.isdir(out):
         raise UsageError(f"--out {out!r} is a file, not a folder")
-    parent = out
-    while not os.path.exists(parent):
-        parent = os.path.dirname(os.path.abspath(parent))
-    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+    parent, ok = _writable_ancestor(out)
+    if not ok:
         raise UsageError(f"cannot write into --out {out!r}: {parent!r} is not a writable folder")
     stem = os.path.join(out, f"{sc.name}-capability")
     nc, png = stem + ".nc", stem + ".png"

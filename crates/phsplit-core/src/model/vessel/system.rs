@@ -143,6 +143,7 @@ impl<'a> VesselSystem<'a> {
             .iter()
             .find_map(|f| f.position_origin())
             .unwrap_or_else(Vector3::zeros);
+        let linear = own::parts_of(vessel);
         Self {
             vessel,
             control_start,
@@ -163,8 +164,8 @@ impl<'a> VesselSystem<'a> {
             gave_up: Default::default(),
             actuators: vessel.actuators(),
             own_dim: vessel.own_dim(),
-            own_parts: own::parts_of(vessel),
-            own_linear_dim: own::parts_of(vessel).iter().map(|p| p.1.len()).sum(),
+            own_linear_dim: linear.iter().map(|p| p.1.len()).sum(),
+            own_parts: linear,
             own_flowing: own::flowing_of(vessel),
             exact_balance: Default::default(),
             s2_memo: Default::default(),

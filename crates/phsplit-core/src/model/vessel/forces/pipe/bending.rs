@@ -99,16 +99,25 @@ impl Chain {
     }
 }
 
-/// Solve the block-banded system with diagonal blocks `d`, off-diagonal blocks `o` (`o[k]` is
-/// both block `(k, k + 1)` and block `(k + 1, k)`: a segment's `−K` in the rows of both its
-/// ends) and `far` (`far[k]` both `(k, k + 2)` and `(k + 2, k)`: a bending spring's), and
-/// right-hand side `g`, by block Gaussian elimination in the band; `None` if a pivot block is
-/// singular.
-pub(super) fn solve_banded(d: &[M3], o: &[M3], far: &[M3], g: &[V3]) -> Option<Vec<V3>> {
-    let n = d.len();
-    // Row k's blocks at columns k − 2 … k + 2.
-    let mut a: Vec<[M3; 5]> = (0..n)
-        .map(|k| {
+/// The block-banded system of the line's Newton iterations with diagonal blocks `d`,
+/// off-diagonal blocks `o` (`o[k]` is both block `(k, k + 1)` and block `(k + 1, k)`: a segment's
+/// `−K` in the rows of both its ends) and `far` (`far[k]` both `(k, k + 2)` and `(k + 2, k)`: a
+/// bending spring's), solved by block Gaussian elimination in the band; its storage is kept
+/// from one iteration to the next.
+#[derive(Debug, Default)]
+pub(super) struct Banded {
+    /// Row k's blocks at columns k − 2 … k + 2.
+    a: Vec<[M3; 5]>,
+    b: Vec<V3>,
+    inv: Vec<M3>,
+}
+
+impl Banded {
+    /// Solve for right-hand side `g` into `x`; `false` if a pivot block is singular.
+    pub(super) fn solve(&mut self, d: &[M3], o: &[M3], far: &[M3], g: &[V3], x: &mut [V3]) -> bool {
+        let n = d.len();
+        self.a.clear();
+        self.a.extend((0..n).map(|k| {
             let get = |j: isize| -> M3 {
                 let j = k as isize + j;
                 if j < 0 || j >= n as isize {
@@ -122,30 +131,34 @@ pub(super) fn solve_banded(d: &[M3], o: &[M3], far: &[M3], g: &[V3]) -> Option<V
                 }
             };
             [get(-2), get(-1), get(0), get(1), get(2)]
-        })
-        .collect();
-    let mut b = g.to_vec();
-    let mut inv = vec![M3::zeros(); n];
-    for k in 0..n {
-        inv[k] = a[k][2].try_inverse()?;
-        for r in k + 1..(k + 3).min(n) {
-            // Column k sits at 2 + k − r in row r.
-            let l = a[r][2 + k - r] * inv[k];
-            for c in k + 1..(k + 3).min(n) {
-                let upper = a[k][2 + c - k];
-                a[r][2 + c - r] -= l * upper;
+        }));
+        self.b.clear();
+        self.b.extend_from_slice(g);
+        self.inv.resize(n, M3::zeros());
+        let (a, b, inv) = (&mut self.a, &mut self.b, &mut self.inv);
+        for k in 0..n {
+            let Some(p) = a[k][2].try_inverse() else {
+                return false;
+            };
+            inv[k] = p;
+            for r in k + 1..(k + 3).min(n) {
+                // Column k sits at 2 + k − r in row r.
+                let l = a[r][2 + k - r] * inv[k];
+                for c in k + 1..(k + 3).min(n) {
+                    let upper = a[k][2 + c - k];
+                    a[r][2 + c - r] -= l * upper;
+                }
+                let bk = b[k];
+                b[r] -= l * bk;
             }
-            let bk = b[k];
-            b[r] -= l * bk;
         }
-    }
-    let mut x = vec![V3::zeros(); n];
-    for k in (0..n).rev() {
-        let mut r = b[k];
-        for c in k + 1..(k + 3).min(n) {
-            r -= a[k][2 + c - k] * x[c];
+        for k in (0..n).rev() {
+            let mut r = b[k];
+            for c in k + 1..(k + 3).min(n) {
+                r -= a[k][2 + c - k] * x[c];
+            }
+            x[k] = inv[k] * r;
         }
-        x[k] = inv[k] * r;
+        true
     }
-    Some(x)
 }

@@ -27,7 +27,7 @@
 //! eliminated (`p₁ = 2m (q₁ − q₀)/h − p₀`) and Newton's method runs on the node positions and
 //! the top's, a block-tridiagonal system of 3×3 blocks solved by block elimination.
 
-use super::bending::solve_banded;
+use super::bending::Banded;
 use nalgebra::{Matrix3, Vector3};
 
 type V3 = Vector3<f64>;
@@ -458,10 +458,13 @@ impl Chain {
             g.iter().map(|v| v.norm_squared()).sum::<f64>().sqrt()
         };
         let mut norm = residual(&p1, &mut f, &mut diag, &mut off, &mut far, &mut g);
+        let (mut band, mut delta) = (Banded::default(), vec![V3::zeros(); n]);
         let mut converged = false;
         let mut trial = p1.clone();
         for _ in 0..MAX_NEWTON {
-            let delta = solve_banded(&diag, &off, &far, &g)?;
+            if !band.solve(&diag, &off, &far, &g, &mut delta) {
+                return None;
+            }
             // Newton's step, halved while it does not lower the residual (a node crossing the
             // seabed or a segment going slack is a kink of the forces, where full steps can
             // cycle).

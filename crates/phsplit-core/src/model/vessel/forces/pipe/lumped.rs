@@ -1,5 +1,5 @@
 //! The dynamic pipe: a lumped-mass line with states of its own, hanging from the hang-off point
-//! of the hull (docs/model.md §5.18; the paper's Fig. 1 and its reference [13], Jensen et al.,
+//! of the hull (docs/model.md §5.18; the paper's Fig. 1 and its reference 13, Jensen et al.,
 //! Ocean Eng. 2010, of a pipe coupled to a DP vessel as a passive system).
 //!
 //! Table `[pipe]` with `model = "lumped_mass"` (the natural catenary, `pipe.rs`, is the other
@@ -171,44 +171,48 @@ pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPi
 }
 
 fn own_states(c: &Chain) -> Vec<OwnState> {
-    let mut v = Vec::with_capacity(c.dim());
-    let st = |name: String, unit: &str, long: String| OwnState {
-        name,
-        unit: unit.into(),
-        long_name: long,
-        initial: 0.0,
-    };
-    for a in ["x", "y", "z"] {
-        v.push(st(
-            format!("pipe_top_{a}"),
-            "m",
-            format!("the pipe's top node, {a} (spatial)"),
-        ));
-    }
-    for i in 1..c.segments {
-        for a in ["x", "y", "z"] {
-            v.push(st(
+    // Each group of 3-vectors: (name of entry `i`, unit, long name of entry `i`), for `i` in its
+    // range (`0..1` for a group of one).
+    type Name = fn(usize, &str) -> (String, String);
+    let groups: [(std::ops::Range<usize>, &str, Name); 4] = [
+        (0..1, "m", |_, a| {
+            (
+                format!("pipe_top_{a}"),
+                format!("the pipe's top node, {a} (spatial)"),
+            )
+        }),
+        (1..c.segments, "m", |i, a| {
+            (
                 format!("pipe_node{i}_{a}"),
-                "m",
                 format!("the pipe's node {i}, {a} (spatial)"),
-            ));
-        }
-    }
-    for i in 1..c.segments {
-        for a in ["x", "y", "z"] {
-            v.push(st(
+            )
+        }),
+        (1..c.segments, "kg m s-1", |i, a| {
+            (
                 format!("pipe_node{i}_p{a}"),
-                "kg m s-1",
                 format!("the pipe's node {i}, momentum {a} (spatial)"),
-            ));
+            )
+        }),
+        (0..1, "m s-1", |_, a| {
+            (
+                format!("pipe_top_return_{a}"),
+                format!("the velocity returning the pipe's top to the hang-off point over the step, {a} (spatial)"),
+            )
+        }),
+    ];
+    let mut v = Vec::with_capacity(c.dim() + 3);
+    for (range, unit, name) in groups {
+        for i in range {
+            for a in ["x", "y", "z"] {
+                let (name, long_name) = name(i, a);
+                v.push(OwnState {
+                    name,
+                    unit: unit.into(),
+                    long_name,
+                    initial: 0.0,
+                });
+            }
         }
-    }
-    for a in ["x", "y", "z"] {
-        v.push(st(
-            format!("pipe_top_return_{a}"),
-            "m s-1",
-            format!("the velocity returning the pipe's top to the hang-off point over the step, {a} (spatial)"),
-        ));
     }
     v
 }

@@ -2,7 +2,7 @@
 //! equilibrium of its weight, its segments and the seabed, directly (no dynamic relaxation), from
 //! the natural catenary with seabed contact.
 
-use super::bending::solve_banded;
+use super::bending::Banded;
 use super::chain::Chain;
 use nalgebra::{Matrix3, Vector3};
 
@@ -54,6 +54,7 @@ impl Chain {
                 (1..n).map(|i| f[i].norm_squared()).sum::<f64>().sqrt()
             };
         let mut norm = residual(self, &p, &mut f, &mut diag, &mut off, &mut far);
+        let (mut band, mut delta) = (Banded::default(), vec![V3::zeros(); n]);
         for _ in 0..200 {
             for i in 1..n {
                 g[i] = -f[i];
@@ -68,8 +69,9 @@ impl Chain {
             for d in diag.iter_mut().skip(1) {
                 *d += M3::identity() * eps;
             }
-            let delta = solve_banded(&diag, &off, &far, &g)
-                .ok_or("the static pipe's Newton system is singular")?;
+            if !band.solve(&diag, &off, &far, &g, &mut delta) {
+                return Err("the static pipe's Newton system is singular".into());
+            }
             let mut lambda = 1.0;
             let mut trial = p.clone();
             loop {
