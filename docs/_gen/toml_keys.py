@@ -73,6 +73,11 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "coefficients": ("kg/m (surge, sway, heave), kg m² (roll, pitch, yaw)", REQ,
                          "six magnitudes `≥ 0` of Fossen's `X_|u|u … N_|r|r` (§5.11)"),
     },
+    "roll_damping": {
+        "linear": ("N m s", "none", "`B₁` of the roll moment `−B₁ p − B₂ |p| p`, `≥ 0` (§5.19); or, instead:"),
+        "critical_fraction": ("-", "none", "`ζ` in [0, 1): `B₁ = 2ζ√(M₄₄ C₄₄)` of the vessel's mass matrix and roll stiffness"),
+        "quadratic": ("N m s²", "0", "`B₂ ≥ 0`; at least one of `B₁`, `B₂` is > 0"),
+    },
     "crossflow_drag": {
         "draft": ("m", REQ, "draught `T`, in (0, 40] (§5.12; [physical ranges](#physical-ranges))"),
         "drag_coefficient": ("-", REQ, "2-D drag coefficient `C_d`, in (0, 5]"),
@@ -239,6 +244,7 @@ SOURCE = {
     "external": "`forces/external.rs`",
     "current": "`forces/current.rs`",
     "damping_quadratic": "`forces/damping_quadratic.rs`",
+    "roll_damping": "`forces/roll_damping.rs`",
     "crossflow_drag": "`forces/crossflow.rs`",
     "pipe": "`forces/pipe.rs`",
     "pipe.lumped_mass": "`forces/pipe/lumped.rs`",
@@ -279,7 +285,8 @@ def accepted() -> dict[str, set[str]]:
                 scenario.load("dp-weather").vessel.to_dict(),
                 phsplit.Vessel.preset("osv").to_dict(),
                 {**paper, "external": {"force": [1.0, 0.0, 0.0]},
-                 "damping_quadratic": {"coefficients": [0.0] * 6}},
+                 "damping_quadratic": {"coefficients": [0.0] * 6},
+                 "roll_damping": {"critical_fraction": 0.05}},
                 _examples()["spring"], _examples()["port_hamiltonian"]]
     out: dict[str, set[str]] = {}
     for table in _core.vessel_tables():
@@ -316,6 +323,7 @@ def _examples() -> dict[str, dict]:
             "current": weather, "pipe": pipelay, "setpoint": pipelay, "thrusters": pipelay, "waves": weather,
             "wind": weather, "crossflow_drag": phsplit.Vessel.preset("osv").to_dict(),
             "damping_quadratic": {**paper, "damping_quadratic": {"coefficients": [1.0] * 6}},
+            "roll_damping": {**paper, "roll_damping": {"critical_fraction": 0.05, "quadratic": 1.0e9}},
             "spring": {**paper, "spring": {"fairlead": [30.0, 0.0, 0.0], "anchor": [700.0, 0.0, -5.0], "stiffness": 1.0e4}},
             "port_hamiltonian": {**paper, "port_hamiltonian": {
                 "name": "port_hamiltonian", "states": ["q", "p"], "units": ["1", "1"], "J": [[0.0, 1.0], [-1.0, 0.0]],
@@ -449,7 +457,7 @@ def render() -> str:
     groups = [
         ("Scenario files", ["simulation", "environment.waves", "environment.wind"]),
         ("Vessel files (and any scenario, table by table)",
-         ["vessel", "initial", "control", "external", "current", "damping_quadratic", "crossflow_drag",
+         ["vessel", "initial", "control", "external", "current", "damping_quadratic", "roll_damping", "crossflow_drag",
           "pipe", "pipe.lumped_mass", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
         ("Sweep files", ["sweep"]),
     ]

@@ -1148,3 +1148,23 @@ CATALOGUE += [
     Bad("port-Hamiltonian state in a unit CF does not know", _ph_dict(units=["furlongs", "kg m2 s-1"]), E,
         ("port_hamiltonian.units[0]", "furlongs", "CF unit")),
 ]
+
+
+CATALOGUE += [
+    # viscous roll damping
+    Bad("roll damping with both linear and critical_fraction",
+        vessel_with("[control]", "[roll_damping]\nlinear = 1.0e7\ncritical_fraction = 0.05\n\n[control]"), E,
+        ("[roll_damping]", "not both")),
+    Bad("roll damping at critical or beyond",
+        vessel_with("[control]", "[roll_damping]\ncritical_fraction = 1.2\n\n[control]"), E,
+        ("roll_damping.critical_fraction", "[0, 1)")),
+    Bad("roll damping with a negative quadratic coefficient",
+        vessel_with("[control]", "[roll_damping]\nquadratic = -4.0e9\n\n[control]"), E,
+        ("roll_damping.quadratic", "≥ 0")),
+    Bad("roll damping table with nothing in it",
+        vessel_with("[control]", "[roll_damping]\nlinear = 0.0\n\n[control]"), E, ("[roll_damping] needs",)),
+    Bad("CLI: RAO at a heading the dataset does not have", cli("rao", "--headings", "100", "--no-plot"), C,
+        ("heading 100 deg is not a direction of the dataset",)),
+    Bad("CLI: RAO of a vessel without a shipped dataset", cli("rao", "--vessel", "supply", "--no-plot"), C,
+        ("--vessel supply", "no shipped dataset", "--dataset")),
+]

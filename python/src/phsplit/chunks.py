@@ -51,5 +51,22 @@ def joined(sols: list[Solution]):
     if len(parts) == 1:
         return parts[0]
     timed = [p.isel(time=slice(1, None)) if i else p for i, p in enumerate(parts)]
-    return xr.concat(timed, dim="time", data_vars="minimal", coords="minimal", compat="override",
-                     combine_attrs="override")
+    ds = xr.concat(timed, dim="time", data_vars="minimal", coords="minimal", compat="override",
+                   combine_attrs="override")
+    for k, values in motion_of(sols).items():   # the whole run's, not the first chunk's
+        if f"{k}_statistics" in ds:
+            ds[f"{k}_statistics"].values[:] = values
+    return ds
+
+
+def motion_of(sols: list[Solution]) -> dict[str, list[float]]:
+    """The motion statistics of the chunks joined (each after the first without its first row):
+    heave (m), roll and pitch (rad), the numbers of ``solution.MOTION_STATISTICS`` over every
+    saved sample, as one Solution's ``motion_statistics`` computes them."""
+    from .solution import MOTION_STATISTICS, statistics_of
+
+    sig = {"heave": [sols[0].x[:, 2]] + [s.x[1:, 2] for s in sols[1:]],
+           "roll": [sols[0].euler[:, 0]] + [s.euler[1:, 0] for s in sols[1:]],
+           "pitch": [sols[0].euler[:, 1]] + [s.euler[1:, 1] for s in sols[1:]]}
+    st = statistics_of({k: np.concatenate(parts) for k, parts in sig.items()})
+    return {k: [st[k][n] for n in MOTION_STATISTICS] for k in st}

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import tempfile
@@ -176,6 +177,32 @@ def _parser() -> argparse.ArgumentParser:
     cp.add_argument("--tolerance", type=float, default=0.01, help="bisection tolerance in wind speed, m/s (default 0.01)")
     cp.add_argument("--out", default="out", help="output folder (default: ./out)")
     cp.add_argument("--no-plot", action="store_true", help="skip the PNG")
+    ra = sub.add_parser(
+        "rao",
+        help="motion RAOs in regular waves, time domain against the frequency domain of a Capytaine dataset",
+        description="For each heading and frequency, the vessel from rest in one regular wave (controller off, "
+        "with Cummins' fluid memory of the dataset unless --no-fluid-memory), the amplitude and phase of each DOF "
+        "from a sinusoid fitted over the last periods, against [-w^2 (M + A(w)) + iw (B(w) + D) + C]^-1 F(w) of the "
+        "same dataset. Writes <out>/<vessel>-rao.nc and a plot <out>/<vessel>-rao.png "
+        "(docs/how-to/seakeeping-rao.md).",
+        epilog="examples:\n  phsplit rao\n  phsplit rao --vessel osv --headings 90 180\n"
+        "  phsplit rao --frequencies 0.44 0.56 0.68 --dofs roll --amplitude 0.05 --out rao/",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    ra.add_argument("--vessel", default="paper", help="a vessel file or a shipped vessel's name (default: paper)")
+    ra.add_argument("--dataset", help="Capytaine dataset (NetCDF) of the hull (default: the shipped vessel's own)")
+    ra.add_argument("--headings", type=float, nargs="+", default=[90.0, 180.0], metavar="DEG",
+                    help="wave directions relative to the bow, directions of the dataset (default: 90 180, beam and head)")
+    ra.add_argument("--frequencies", type=float, nargs="+", metavar="RAD_S",
+                    help="wave frequencies, rad/s (default: the dataset's within 0.3-1.9 rad/s)")
+    ra.add_argument("--dofs", nargs="+", default=["heave", "roll", "pitch"],
+                    choices=["surge", "sway", "heave", "roll", "pitch", "yaw"], help="DOFs (default: heave roll pitch)")
+    ra.add_argument("--amplitude", type=float, default=0.1, help="wave amplitude, m (default 0.1)")
+    ra.add_argument("--h", type=float, default=0.5, help="step, s (default 0.5)")
+    ra.add_argument("--t-end", type=float, default=600.0, help="length of each run, s (default 600)")
+    ra.add_argument("--no-fluid-memory", action="store_true", help="the vessel as it is: its own added mass and damping")
+    ra.add_argument("--out", default="out", help="output folder (default: ./out)")
+    ra.add_argument("--no-plot", action="store_true", help="skip the PNG")
     w.add_argument("sweep", help="sweep TOML file ([simulation] + [sweep])")
     w.add_argument("--out", help="result store (a folder; default: <sweep name>.store)")
     w.add_argument("--scheduler", help="address of an existing Dask scheduler, e.g. tcp://host:8786")
@@ -401,6 +428,10 @@ def _simulate(args) -> int:
         bar.close()
         with _DeferSignals():
             if nc_file is not None:
+                if sols:
+                    from .chunks import motion_of
+
+                    _write_motion(nc_file, motion_of(sols))
                 nc_file.setncattr("status", status)
                 nc_file.setncattr("steps", done)
                 nc_file.close()
@@ -439,6 +470,15 @@ def _simulate(args) -> int:
     print(f"energy H: {sols[0].energy[0]:.6e} -> {last.energy[-1]:.6e} J; worst relative ledger residual {rr:.2e}")
     booked = {a: sum(float(s_.ledger.by_account[a].sum()) for s_ in sols) for a in last.ledger.by_account}
     print("ledger, J: " + ", ".join(f"{a} {last.ledger.kinds[a]} {v:.6e}" for a, v in booked.items()))
+    if "waves" in sc.vessel.to_dict():
+        from .chunks import motion_of
+
+        m = motion_of(sols)
+        deg = 180.0 / math.pi
+        print(f"motion over the run: heave σ {m['heave'][1]:.3g} m (max {m['heave'][3]:.3g} m), "
+              f"roll σ {deg * m['roll'][1]:.3g}° (max {deg * m['roll'][3]:.3g}°), "
+              f"pitch σ {deg * m['pitch'][1]:.3g}° (max {deg * m['pitch'][3]:.3g}°); significant (4σ) "
+              f"{m['heave'][4]:.3g} m, {deg * m['roll'][4]:.3g}°, {deg * m['pitch'][4]:.3g}°")
     for f in files:
         print(f"wrote {os.path.abspath(f)}")
     if status != "completed":
@@ -481,6 +521,14 @@ def _seconds_since_start() -> float:
         return max(0.0, uptime - int(after_name[19]) / os.sysconf("SC_CLK_TCK"))  # field 22: start time
     except (OSError, ValueError, IndexError):  # pragma: no cover - systems without /proc
         return time.perf_counter() - phsplit._STARTED
+
+
+def _write_motion(nc_file, m: dict) -> None:
+    """The whole run's motion statistics into the file's ``<dof>_statistics`` (written by the
+    first chunk with that chunk's)."""
+    for k in m:
+        if f"{k}_statistics" in nc_file.variables:
+            nc_file.variables[f"{k}_statistics"][:] = m[k]
 
 
 def _append(nc_file, path: str, sol, first: bool, attrs: dict):
@@ -760,6 +808,90 @@ def _capability(args) -> int:
     return 0
 
 
+def _rao(args) -> int:
+    import numpy as np
+    import xarray as xr
+
+    from . import radiation, seakeeping
+    from . import scenario as scn
+    from .files import publish, temporary_beside
+    from .plotting import plot_rao
+
+    vessel = scn.vessel_named(args.vessel)
+    name = _vessel_stem(args.vessel)
+    dataset = args.dataset
+    if dataset is None:
+        if args.vessel not in seakeeping.DATASETS:
+            raise UsageError(f"--vessel {args.vessel}: no shipped dataset for this vessel (shipped for: "
+                             f"{', '.join(seakeeping.DATASETS)}); give --dataset")
+        dataset = seakeeping.DATASETS[args.vessel]
+    elif not os.path.isfile(dataset):
+        raise UsageError(f"--dataset {dataset!r} is not a file")
+    out = args.out
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise UsageError(f"--out {out!r} is a file, not a folder")
+    parent, ok = _writable_ancestor(out)
+    if not ok:
+        raise UsageError(f"cannot write into --out {out!r}: {parent!r} is not a writable folder")
+    nc, png = os.path.join(out, f"{name}-rao.nc"), os.path.join(out, f"{name}-rao.png")
+    for f in (nc,) if args.no_plot else (nc, png):
+        if os.path.isdir(f):
+            raise UsageError(f"cannot write {f!r}: a folder of that name is in the way")
+    data = radiation.retardation_data(dataset, vessel=vessel)
+    freqs = args.frequencies
+    if freqs is None:
+        w = data[0]
+        freqs = [float(x) for x in w if 0.3 - 1e-9 <= x <= 1.9 + 1e-9]
+    # every argument checked (by a run-free call per heading) before the first run
+    for hd in args.headings:
+        seakeeping.rao(vessel, freqs, hd, tuple(args.dofs), amplitude=args.amplitude, dataset=dataset,
+                       fluid_memory=not args.no_fluid_memory, h=args.h, t_end=args.t_end, check_only=True)
+    memory = False if args.no_fluid_memory else radiation.fluid_memory(dataset, vessel=vessel)
+    parts = []
+    for hd in args.headings:
+        print(f"rao of {name}: heading {hd:g} deg, {len(freqs)} frequencies ...", flush=True)
+        parts.append(seakeeping.rao(vessel, freqs, hd, tuple(args.dofs), amplitude=args.amplitude, dataset=dataset,
+                                    fluid_memory=memory, h=args.h, t_end=args.t_end))
+    ds = xr.concat([p.expand_dims(heading=[float(p.attrs["heading"])]) for p in parts], dim="heading",
+                   combine_attrs="override")
+    ds["heading"].attrs.update({"units": "degree", "long_name": "wave direction relative to the bow (90 beam, 180 head seas)"})
+    ds.attrs.pop("heading", None)
+    ds.attrs["vessel"] = args.vessel
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
+    tmp = temporary_beside(nc, prefix=".rao-")
+    try:  # under a temporary name, renamed when complete: nothing half-written on Ctrl-C
+        ds.to_netcdf(tmp)
+        publish(tmp, nc)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+    if not args.no_plot:
+        plot_rao(ds, png, title=f"{name}: RAO")   # written whole or not at all
+    for hd in ds.heading.values:
+        row = ds.sel(heading=hd)
+        worst = []
+        peak = {k: float(np.nanmax(row[f"{k}_amplitude_frequency_domain"].values)) for k in args.dofs}
+        for k in args.dofs:
+            fd = row[f"{k}_amplitude_frequency_domain"].values
+            dev = np.abs(row[f"{k}_deviation"].values)
+            kind = [j for j in args.dofs if (j in ("roll", "pitch", "yaw")) == (k in ("roll", "pitch", "yaw"))]
+            if peak[k] < 0.01 * max(peak[j] for j in kind):   # pitch in beam seas, roll in head seas
+                worst.append(f"{k} not excited")
+                continue
+            big = fd >= 0.05 * peak[k]
+            worst.append(f"{k} {100 * float(np.nanmax(dev[big])):.1f} %")
+        print(f"heading {hd:g} deg: largest deviation from the frequency domain where the RAO is >= 5 % of its "
+              f"peak: {', '.join(worst)}; ledger residual <= {float(row['ledger_residual'].max()):.1e}")
+    print(f"wrote {os.path.abspath(nc)}")
+    if not args.no_plot:
+        print(f"wrote {os.path.abspath(png)}")
+    return 0
+
+
 def _angles(step: float) -> list[float]:
     """0, step, 2 step, ... below 360 degrees."""
     return [i * step for i in range(int(round(360.0 / step)))]
@@ -831,6 +963,8 @@ def main(argv: list[str] | None = None) -> int:
             return _vessels()
         if args.command == "capability":
             return _capability(args)
+        if args.command == "rao":
+            return _rao(args)
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

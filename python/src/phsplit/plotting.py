@@ -367,3 +367,38 @@ def pipe_figure(ds, snapshots: int = 8, title: str | None = None):
     fig.suptitle(title or "the dynamic pipe: profile, envelope and tensions")
     fig.tight_layout()
     return fig
+
+
+def plot_rao(ds, path: str, title: str | None = None) -> None:
+    """An RAO dataset of :func:`phsplit.rao` (one heading, or several along ``heading`` as
+    ``phsplit rao`` writes it), written atomically to ``path``: per DOF the amplitude per unit
+    wave amplitude against frequency, the frequency domain as lines and the time domain as
+    markers, one colour per heading."""
+    import matplotlib.pyplot as plt
+
+    dofs = [k[: -len("_amplitude")] for k in ds.data_vars if k.endswith("_amplitude")]
+    headings = ds["heading"].values if "heading" in ds.dims else [ds.attrs.get("heading")]
+    fig, axes = plt.subplots(1, len(dofs), figsize=(4.2 * len(dofs), 3.6), squeeze=False)
+    w = ds["frequency"].values
+    for ax, k in zip(axes[0], dofs):
+        rot = k in ("roll", "pitch", "yaw")
+        scale = 180.0 / np.pi if rot else 1.0
+        for j, hd in enumerate(headings):
+            row = ds.sel(heading=hd) if "heading" in ds.dims else ds
+            c = f"C{j}"
+            ax.plot(w, scale * row[f"{k}_amplitude_frequency_domain"].values, "-", color=c, lw=1.2,
+                    label=f"{hd:g}°, frequency domain")
+            ax.plot(w, scale * row[f"{k}_amplitude"].values, "o", color=c, ms=4, mfc="none",
+                    label=f"{hd:g}°, time domain")
+        ax.set_xlabel("wave frequency (rad/s)")
+        ax.set_ylabel(f"{k} ({'deg' if rot else 'm'} per m of wave amplitude)")
+        ax.set_title(k)
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    try:
+        _save(fig, path)
+    finally:
+        plt.close(fig)

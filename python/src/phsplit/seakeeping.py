@@ -30,6 +30,8 @@ from . import _core, cf, hydro, radiation, sea
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 #: The shipped box of the paper's vessel (dp-weather's dataset).
 DEFAULT_DATASET = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios", "paper_box_capytaine.nc")
+#: The shipped Capytaine dataset of each shipped vessel that has one (``phsplit rao``'s default).
+DATASETS = {"paper": DEFAULT_DATASET}
 _UNITS = {"surge": "m m-1", "sway": "m m-1", "heave": "m m-1", "roll": "rad m-1", "pitch": "rad m-1", "yaw": "rad m-1"}
 
 
@@ -37,21 +39,72 @@ def _err(msg: str) -> _core.InvalidInputError:
     return _core.InvalidInputError(msg)
 
 
+def _skew(r) -> np.ndarray:
+    return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+
+
 def linear_model(vessel):
-    """``(M, D, C)``: the rigid body's mass matrix (centre of gravity at the origin), the linear
-    damping (``damping_matrix`` or the diagonal) and the restoring linearised about upright
-    (docs/model.md §2.3) of a vessel, without its added mass."""
-    p = vessel.to_dict()["vessel"]
+    """``(M, D, C)`` of a vessel about its body origin, without its added mass: the rigid body's
+    mass matrix with the centre of gravity at ``r_g`` (Fossen 2021, eq. 3.44:
+    ``[[m I, −m S(r_g)], [m S(r_g), I_g − m S(r_g)²]]``, ``I_g`` the file's inertia about the
+    centre of gravity), the linear damping (``damping_matrix`` or the diagonal, plus the linear
+    part ``B₁`` of ``[roll_damping]``) and the restoring linearised about upright with the centre
+    of flotation ``(x_F, y_F)`` (docs/model.md §2.3, §5.15: ``G33 = c``, ``G34 = y_F c``,
+    ``G35 = −x_F c``, ``G44 = W GM_T + y_F² c``, ``G45 = −x_F y_F c``, ``G55 = W GM_L + x_F² c``,
+    ``c = ρ g A_wp``)."""
+    d = vessel.to_dict()
+    p = d["vessel"]
     m = p["mass"]
-    M = np.diag([m, m, m, *p["inertia"]])
+    rg = np.asarray(p.get("center_of_gravity", [0.0, 0.0, 0.0]), float)
+    S = _skew(rg)
+    M = np.zeros((6, 6))
+    M[:3, :3] = m * np.eye(3)
+    M[:3, 3:] = -m * S
+    M[3:, :3] = m * S
+    M[3:, 3:] = np.diag(p["inertia"]) - m * S @ S
     if "damping_matrix" in p:
         D = np.array(p["damping_matrix"], float)
     else:
         D = np.diag([*p["damping_translational"], *p["damping_rotational"]])
     g, rho = p["gravity"], p["water_density"]
-    C = np.diag([0.0, 0.0, rho * g * p["waterplane_area"], m * g * p["gm_transverse"],
-                 m * g * p["gm_longitudinal"], 0.0])
+    c = rho * g * p["waterplane_area"]
+    xf, yf = p.get("flotation_center_x", 0.0), p.get("flotation_center_y", 0.0)
+    W = m * g
+    C = np.zeros((6, 6))
+    C[2, 2] = c
+    C[2, 3] = C[3, 2] = yf * c
+    C[2, 4] = C[4, 2] = -xf * c
+    C[3, 3] = W * p["gm_transverse"] + yf ** 2 * c
+    C[3, 4] = C[4, 3] = -xf * yf * c
+    C[4, 4] = W * p["gm_longitudinal"] + xf ** 2 * c
+    b1, _ = roll_damping(vessel)
+    D = D.copy()
+    D[3, 3] += b1
     return M, D, C
+
+
+def roll_damping(vessel) -> tuple[float, float]:
+    """``(B₁, B₂)`` of the vessel's ``[roll_damping]`` (N m s, N m s²; zeros without one), ``B₁``
+    from ``critical_fraction`` as the core computes it: ``2ζ√(M₄₄ C₄₄)``, ``M₄₄`` the roll entry
+    of the mass matrix with the vessel's own added mass."""
+    d = vessel.to_dict()
+    t = d.get("roll_damping")
+    if not t:
+        return 0.0, 0.0
+    b2 = float(t.get("quadratic", 0.0))
+    if "linear" in t:
+        return float(t["linear"]), b2
+    zeta = float(t.get("critical_fraction", 0.0))
+    if zeta == 0.0:
+        return 0.0, b2
+    p = d["vessel"]
+    rg = np.asarray(p.get("center_of_gravity", [0.0, 0.0, 0.0]), float)
+    m44 = p["inertia"][0] + p["mass"] * (rg[1] ** 2 + rg[2] ** 2)
+    if "added_mass" in p:
+        m44 += np.asarray(p["added_mass"], float)[3, 3]
+    c44 = p["mass"] * p["gravity"] * p["gm_transverse"] + p.get("flotation_center_y", 0.0) ** 2 * (
+        p["water_density"] * p["gravity"] * p["waterplane_area"])
+    return 2.0 * zeta * math.sqrt(m44 * c44), b2
 
 
 def waves_table(vessel, dataset=DEFAULT_DATASET) -> dict:
@@ -61,10 +114,16 @@ def waves_table(vessel, dataset=DEFAULT_DATASET) -> dict:
     return {k: out["waves"][k] for k in ("rao_frequencies", "rao_directions", "force_rao_real", "force_rao_imag")}
 
 
-def frequency_rao(vessel, omega: float, heading: float, dataset=DEFAULT_DATASET, *, data=None) -> np.ndarray:
+def frequency_rao(vessel, omega: float, heading: float, dataset=DEFAULT_DATASET, *, data=None,
+                  amplitude: float | None = None) -> np.ndarray:
     """``[−ω²(M + A(ω)) + iω(B(ω) + D) + C]⁻¹ F(ω)`` for a wave of unit amplitude (complex, the
     six DOFs), ``A``, ``B``, ``F`` linear in ω between the dataset's frequencies. ``data``: the
-    :func:`phsplit.radiation.retardation_data` of the dataset and vessel, read once."""
+    :func:`phsplit.radiation.retardation_data` of the dataset and vessel, read once.
+
+    A quadratic roll damping ``B₂`` (``[roll_damping]``) makes the response depend on the wave's
+    ``amplitude`` (m, then required): it enters as its harmonic equivalent linear damping
+    ``(8/3π) ω φ_a B₂`` (the energy per cycle of ``B₂|φ'|φ'`` in ``φ = φ_a cos ωt``; ITTC
+    7.5-02-07-04.5, Himeno 1981), with the roll amplitude ``φ_a`` found by fixed-point iteration."""
     w, K, Ainf, _, out = data if data is not None else radiation.retardation_data(dataset, vessel=vessel)
     if not w[0] - 1e-9 <= omega <= w[-1] + 1e-9:
         raise _err(f"frequencies: {omega:g} rad/s is outside the dataset's {w[0]:g}-{w[-1]:g} rad/s")
@@ -88,7 +147,22 @@ def frequency_rao(vessel, omega: float, heading: float, dataset=DEFAULT_DATASET,
         s = (omega - w[i - 1]) / (w[i] - w[i - 1])
         A, B, F = ((1 - s) * X[i - 1] + s * X[i] for X in (A_all, B_all, Fw))
     M, D, C = linear_model(vessel)
-    return np.linalg.solve(-omega ** 2 * (M + A) + 1j * omega * (B + D) + C, F)
+    Z = -omega ** 2 * (M + A) + 1j * omega * (B + D) + C
+    xi = np.linalg.solve(Z, F)
+    _, b2 = roll_damping(vessel)
+    if b2 == 0.0:
+        return xi
+    if amplitude is None:
+        raise _err("the vessel's roll_damping.quadratic makes the RAO depend on the wave amplitude: give amplitude= (m)")
+    eq = 8.0 / (3.0 * math.pi) * omega * b2
+    for _ in range(200):
+        Zk = Z.copy()
+        Zk[3, 3] += 1j * omega * eq * amplitude * abs(xi[3])
+        new = np.linalg.solve(Zk, F)
+        if abs(abs(new[3]) - abs(xi[3])) <= 1e-12 * abs(new[3]):
+            return new
+        xi = 0.5 * (xi + new)   # damped: the map is monotone in |xi_4|
+    raise _core.IntegrationError(f"the equivalent linearisation of the quadratic roll damping did not converge at {omega:g} rad/s")
 
 
 def _fit(t, sig, omega):
@@ -126,6 +200,23 @@ def time_rao(vessel, waves, omega: float, heading: float, *, amplitude: float = 
     return {k: _fit(t, signal[k], omega) / ref for k in dofs}, s
 
 
+def drift(s, omega: float, periods: float) -> float:
+    """How far (m) the body origin moved horizontally over the fit window of a :func:`time_rao`
+    run: the first-order loads on the nonlinear rigid body have a mean part (products of the
+    wave-frequency motions and loads, growing as the amplitude squared), and with the
+    controller off nothing holds the vessel on station."""
+    t_end = float(s.t[-1])
+    keep = s.t >= t_end - periods * 2 * math.pi / omega - 1e-9
+    xy = s.x[keep, :2]
+    return float(np.linalg.norm(xy[-1] - xy[0]))
+
+
+#: The largest drift over the fit window, as a fraction of the wavelength, that :func:`rao`
+#: accepts without a warning: 2 % shifts the wave's phase at the hull by 0.13 rad over the
+#: window, and the encounter frequency by 2 % of a period over the window's length.
+DRIFT_FRACTION = 0.02
+
+
 def _positive(name, x):
     try:
         x = float(x)
@@ -138,7 +229,7 @@ def _positive(name, x):
 
 def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *, amplitude: float = 0.1,
         dataset=None, fluid_memory=True, h: float = 0.5, t_end: float = 600.0, periods: float = 10.0,
-        method: str = "sp4"):
+        method: str = "sp4", check_only: bool = False):
     """The RAO of ``vessel`` at ``frequencies`` (rad/s) in regular waves from ``heading``
     (degrees, the waves' direction relative to the bow: 90 beam seas, 180 head seas; a
     direction of the dataset), in the time domain against the frequency domain, as an
@@ -156,19 +247,19 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
     ``fluid_memory``: ``True`` (fit Cummins' memory here, :func:`phsplit.radiation.with_fluid_memory`),
     a :class:`phsplit.radiation.FluidMemory` of the same dataset and vessel, or ``False`` (the
     vessel as it is, its own added mass and damping); ``amplitude`` (m), the step ``h`` (s),
-    ``t_end`` (s), ``periods`` (the fit window) and ``method`` of the runs."""
+    ``t_end`` (s), ``periods`` (the fit window) and ``method`` of the runs. ``check_only``: check
+    the arguments and return ``None`` without a run.
+
+    ``horizontal_drift`` (m) is how far the vessel moved over each fit window (controller off,
+    the first-order loads on the nonlinear body have a mean part growing as the amplitude
+    squared); past :data:`DRIFT_FRACTION` of the wavelength a :class:`phsplit.ModelRangeWarning`
+    says so, as the wave the hull meets is then no longer the regular one."""
     import xarray as xr
 
     from .simulate import Vessel
 
     if not isinstance(vessel, Vessel):
         raise _err(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
-    vp = vessel.to_dict()["vessel"]
-    off = [k for k in ("center_of_gravity", "flotation_center_x", "flotation_center_y")
-           if np.any(np.asarray(vp.get(k, 0.0), float) != 0.0)]
-    if off:
-        raise _err(f"vessel: the frequency-domain RAO here takes the centre of gravity and of flotation at the "
-                   f"origin, and this vessel sets {off[0]}")
     try:
         freqs = np.atleast_1d(np.asarray(frequencies, dtype=float))
     except (TypeError, ValueError):
@@ -200,7 +291,11 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
     dataset = DEFAULT_DATASET if dataset is None else dataset
     data = radiation.retardation_data(dataset, vessel=vessel)
     for w in freqs:   # refused before any run
-        frequency_rao(vessel, float(w), heading, dataset, data=data)
+        frequency_rao(vessel, float(w), heading, dataset, data=data, amplitude=amplitude)
+    if not (fluid_memory is True or fluid_memory is False or isinstance(fluid_memory, radiation.FluidMemory)):
+        raise _err(f"fluid_memory must be True, False or a FluidMemory, got {type(fluid_memory).__name__}")
+    if check_only:
+        return None
     if fluid_memory is True:
         td = radiation.with_fluid_memory(vessel, dataset)
     elif isinstance(fluid_memory, radiation.FluidMemory):
@@ -213,13 +308,21 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
     n = len(freqs)
     out = {k: np.zeros(n, complex) for k in dofs}
     ref = {k: np.zeros(n, complex) for k in dofs}
-    residual, booked = np.zeros(n), np.zeros(n)
+    residual, booked, moved = np.zeros(n), np.zeros(n), np.zeros(n)
     for i, w in enumerate(freqs):
         got, s = time_rao(td, wt, float(w), heading, amplitude=amplitude, h=h, t_end=t_end, periods=periods,
                           method=method, dofs=dofs)
-        fd = frequency_rao(vessel, float(w), heading, dataset, data=data)
+        fd = frequency_rao(td, float(w), heading, dataset, data=data, amplitude=amplitude)
         for k in dofs:
             out[k][i], ref[k][i] = got[k], fd[DOFS.index(k)]
+        moved[i] = drift(s, float(w), periods)
+        wavelength = 2 * math.pi * 9.81 / float(w) ** 2   # deep water (the dataset's)
+        if moved[i] > DRIFT_FRACTION * wavelength:
+            from .runner import ModelRangeWarning
+            warnings.warn(f"rao at {float(w):g} rad/s: the vessel drifted {moved[i]:.3g} m over the fit window "
+                          f"({100 * moved[i] / wavelength:.2g} % of the {wavelength:.4g} m wavelength), so the wave "
+                          f"it meets is no longer the regular one; give a smaller amplitude (now {amplitude:g} m)",
+                          ModelRangeWarning, stacklevel=2)
         residual[i] = float(s.ledger.relative_residual().max())
         booked[i] = float(s.ledger.by_account["radiation"].sum()) if "radiation" in s.ledger.by_account else 0.0
     variables = {}
@@ -232,6 +335,7 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
         variables[f"{k}_amplitude_frequency_domain"] = ("frequency", np.abs(ref[k]), {"units": u, "long_name": f"{k} amplitude per unit wave amplitude, frequency domain"})
         variables[f"{k}_phase_frequency_domain"] = ("frequency", np.angle(ref[k]), {"units": "rad", "long_name": f"{k} phase against the wave elevation, frequency domain"})
         variables[f"{k}_deviation"] = ("frequency", dev, {"units": "1", "long_name": f"{k} time-domain amplitude over the frequency-domain one, minus one"})
+    variables["horizontal_drift"] = ("frequency", moved, {"units": "m", "long_name": "horizontal distance the body origin moved over the fit window"})
     variables["ledger_residual"] = ("frequency", residual, {"units": "1", "long_name": "largest relative residual of the run's ledger"})
     variables["radiation_dissipated"] = ("frequency", booked, {"units": "J", "long_name": "energy booked by the fluid memory's account over the run"})
     ds = xr.Dataset(variables, coords={"frequency": ("frequency", freqs, {"units": "rad s-1", "long_name": "wave angular frequency"})})

@@ -12,6 +12,21 @@ import numpy as np
 from . import _core, _provided, cf
 from .settings import settings_to_toml
 
+#: The statistics of :meth:`Solution.motion_statistics`, in the order a dataset stores them.
+MOTION_STATISTICS = ("mean", "std", "rms", "max", "significant")
+
+
+def statistics_of(signals: dict) -> dict[str, dict[str, float]]:
+    """Per named signal (a sequence of samples) the numbers of :data:`MOTION_STATISTICS`."""
+    out = {}
+    for name, sig in signals.items():
+        sig = np.asarray(sig, dtype=float)
+        std = float(np.std(sig))
+        out[name] = {"mean": float(np.mean(sig)), "std": std, "rms": float(np.sqrt(np.mean(sig ** 2))),
+                     "max": float(np.max(np.abs(sig))), "significant": 4.0 * std}
+    return out
+
+
 @dataclass(frozen=True)
 class Ledger:
     """Energy balance per saved interval (J): ``dH = supplied - dissipated + residual``.
@@ -198,12 +213,7 @@ class Solution:
         if not np.isfinite(after) or keep.sum() < 2:
             raise _core.InvalidInputError(f"after must leave at least two saved samples (the run saved "
                                           f"{self.t[0]:g}-{self.t[-1]:g} s), got {after!r}")
-        out = {}
-        for name, sig in (("heave", self.x[keep, 2]), ("roll", self.euler[keep, 0]), ("pitch", self.euler[keep, 1])):
-            std = float(np.std(sig))
-            out[name] = {"mean": float(np.mean(sig)), "std": std, "rms": float(np.sqrt(np.mean(sig ** 2))),
-                         "max": float(np.max(np.abs(sig))), "significant": 4.0 * std}
-        return out
+        return statistics_of({"heave": self.x[keep, 2], "roll": self.euler[keep, 0], "pitch": self.euler[keep, 1]})
 
     def settings_toml(self) -> str:
         """The run's settings as a ``[simulation]`` TOML table (what a scenario file takes)."""
@@ -290,6 +300,16 @@ class Solution:
             data["initial_state"] = var(("state",), y0, "1",
                                       "initial state (p, m, Q column-major, mu, x, phi_theta, phi_x; "
                                       + "".join(t + "; " for t in tail) + "SI units)")
+        if len(self.t) >= 2:
+            # the motion statistics over every saved sample (motion_statistics; the CLI's file
+            # holds the whole run's)
+            st = self.motion_statistics()
+            coords["statistic_name"] = ("statistic", np.array(MOTION_STATISTICS), {
+                "long_name": "statistic over every saved sample (std: sigma; significant: 4 sigma)"})
+            for k, unit in (("heave", "m"), ("roll", "rad"), ("pitch", "rad")):
+                data[f"{k}_statistics"] = var(("statistic",), [st[k][n] for n in MOTION_STATISTICS], unit,
+                                              f"{k}: mean, standard deviation, RMS about zero, largest magnitude, "
+                                              f"significant double amplitude")
         ds = xr.Dataset(data, coords=coords)
         ds["time"].encoding["_FillValue"] = None  # CF 2.5.1: no fill value on a coordinate
         # Time is the record (unlimited) dimension, as in the CLI's files: appendable, and the

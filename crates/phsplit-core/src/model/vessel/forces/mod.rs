@@ -57,6 +57,7 @@ pub mod pid;
 pub mod pipe;
 pub mod port_hamiltonian;
 pub mod restoring;
+pub mod roll_damping;
 pub mod spring;
 pub mod thrusters;
 pub mod waves;
@@ -76,6 +77,7 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
         damping_quadratic::build,
     ),
     ("crossflow_drag", &["crossflow_drag"], crossflow::build),
+    ("roll_damping", &["roll_damping"], roll_damping::build),
     ("restoring", &["vessel"], restoring::build),
     ("pid", &["control", "setpoint", "thrusters"], pid::build),
     ("external", &["external"], external::build),

@@ -5,7 +5,7 @@
 use super::super::forces::S2Builder;
 use super::s2;
 use super::VesselSystem;
-use nalgebra::Matrix3;
+use nalgebra::{DMatrix, Matrix3};
 
 /// The periods `2π/|λ|` of the oscillating eigenvalues of `a` (times `scale`), ascending.
 fn periods_of(ev: impl Iterator<Item = nalgebra::Complex<f64>>, scale: f64) -> Vec<f64> {
@@ -21,6 +21,60 @@ fn periods_of(ev: impl Iterator<Item = nalgebra::Complex<f64>>, scale: f64) -> V
     }
     out.sort_by(|x, y| x.total_cmp(y));
     out
+}
+
+/// A diagonal similarity `D⁻¹ A D` (powers of two, so exact) that brings each row's and
+/// column's off-diagonal norms close (Parlett & Reinsch, *Numer. Math.* 13, 1969, as LAPACK's
+/// `gebal` without its permutations): the eigenvalues are `a`'s, computed far more accurately
+/// when its entries span many decades (the momenta's kg against the angles' radians).
+fn balanced(mut a: DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    for _ in 0..100 {
+        let mut done = true;
+        for i in 0..n {
+            let c: f64 = (0..n).filter(|&j| j != i).map(|j| a[(j, i)].abs()).sum();
+            let r: f64 = (0..n).filter(|&j| j != i).map(|j| a[(i, j)].abs()).sum();
+            if c == 0.0 || r == 0.0 {
+                continue;
+            }
+            let mut f = 1.0;
+            let (mut cc, mut rr) = (c, r);
+            while cc < rr / 2.0 {
+                cc *= 2.0;
+                rr /= 2.0;
+                f *= 2.0;
+            }
+            while cc >= rr * 2.0 {
+                cc /= 2.0;
+                rr *= 2.0;
+                f /= 2.0;
+            }
+            if (cc + rr) < 0.95 * (c + r) {
+                done = false;
+                for j in 0..n {
+                    a[(i, j)] /= f;
+                    a[(j, i)] *= f;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    a
+}
+
+/// The oscillating periods of `a`'s eigenvalues, `a` balanced first.
+fn periods(a: DMatrix<f64>) -> Vec<f64> {
+    let a = balanced(a);
+    let scale = a.amax().max(f64::MIN_POSITIVE);
+    match (a / scale)
+        .try_schur(1e-15, 10_000)
+        .map(|s| s.complex_eigenvalues())
+    {
+        Some(ev) => periods_of(ev.iter().cloned(), scale),
+        None => Vec::new(),
+    }
 }
 
 impl VesselSystem<'_> {
@@ -41,16 +95,7 @@ impl VesselSystem<'_> {
         // The 18×18 system (the two block systems and what couples them), without the
         // constant column.
         let full = s2::augmented(&b);
-        let a: nalgebra::SMatrix<f64, 18, 18> = full.fixed_view::<18, 18>(0, 0).into_owned();
-        // Balance by the momentum scale (u = M v): the raw entries span many decades.
-        let scale = a.abs().max().max(f64::MIN_POSITIVE);
-        match (a / scale)
-            .try_schur(1e-15, 10_000)
-            .map(|s| s.complex_eigenvalues())
-        {
-            Some(ev) => periods_of(ev.iter().cloned(), scale),
-            None => Vec::new(),
-        }
+        periods(DMatrix::from_fn(18, 18, |i, j| full[(i, j)]))
     }
 
     /// [`Self::natural_periods`] of the dense system with the components' own states, balanced
@@ -58,14 +103,6 @@ impl VesselSystem<'_> {
     fn natural_periods_own(&self, b: &S2Builder) -> Vec<f64> {
         let (a, _) = self.dense_balanced(b);
         let n = a.nrows() - 1;
-        let a = a.view((0, 0), (n, n)).into_owned();
-        let scale = a.amax().max(f64::MIN_POSITIVE);
-        match (a / scale)
-            .try_schur(1e-15, 10_000)
-            .map(|s| s.complex_eigenvalues())
-        {
-            Some(ev) => periods_of(ev.iter().cloned(), scale),
-            None => Vec::new(),
-        }
+        periods(a.view((0, 0), (n, n)).into_owned())
     }
 }
