@@ -8,7 +8,7 @@ BIN    := $(VENV)/bin
 OUT    ?= out
 RUST_SRC := $(shell find crates -name '*.rs' -o -name 'Cargo.toml' -o -name '*.toml' | sort) Cargo.toml
 
-.PHONY: run test test-rust test-python docs build reproduce bench bench-quick fuzz elliptic-refs rigid-body-refs capytaine-box clean
+.PHONY: run test test-rust test-python docs build reproduce bench bench-quick fuzz elliptic-refs rigid-body-refs capytaine-box capytaine-hulls clean
 
 run: $(VENV)/.built
 	$(BIN)/phsplit simulate --out $(OUT)
@@ -99,6 +99,14 @@ capytaine-box:
 	test -x .venv-capytaine/bin/python || $(PYTHON) -m venv .venv-capytaine
 	.venv-capytaine/bin/python -m pip install --quiet "capytaine>=3,<4"
 	.venv-capytaine/bin/python scripts/gen_capytaine_box.py
+
+# Hydrodynamic data of a ship-like hull fitted to the osv preset
+# (python/src/phsplit/scenarios/osv_capytaine.nc) and the peer RAO of the preset computed by
+# Capytaine (python/tests/data/osv_capytaine_rao.nc): scripts/gen_capytaine_hulls.py.
+capytaine-hulls:
+	test -x .venv-capytaine/bin/python || $(PYTHON) -m venv .venv-capytaine
+	.venv-capytaine/bin/python -m pip install --quiet "capytaine>=3,<4"
+	.venv-capytaine/bin/python scripts/gen_capytaine_hulls.py
 
 clean:
 	rm -rf $(VENV) target $(OUT)

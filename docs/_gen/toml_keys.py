@@ -199,7 +199,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "spreading": ("-", "none (long-crested)", "exponent `s` of the cos-2s spreading function"),
         "seed": ("-", "0", "the same seed, the same sea"),
         "components": ("-", "200", "number of regular components, 1 to 10,000"),
-        "omega_range": ("rad/s", "[0.5, 3] ω_p", "two increasing frequencies > 0"),
+        "omega_range": ("rad/s", "[0.5, 3] ω_p", "two increasing frequencies > 0; by default, with `hydro`, within the dataset's frequencies"),
         "hydro": ("-", "none", "a Capytaine dataset (path relative to the scenario) for the transfer functions"),
         "symmetric": ("-", "false", "mirror 0–180 degrees for a port–starboard symmetric hull; without it, waves "
                       "from a direction the dataset does not cover are refused"),

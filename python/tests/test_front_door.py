@@ -11,6 +11,7 @@ import math
 import os
 import re
 import subprocess
+from pathlib import Path
 import sys
 import time
 
@@ -44,16 +45,30 @@ def test_vessel_option_keeps_the_scenarios_operation_and_environment(tmp_path):
 
 
 def test_vessel_option_runs_the_osv_in_the_scenarios_whole_sea(tmp_path):
-    """The OSV in dp-weather: its own components and the scenario's waves, wind and current, each
-    booked in its own account (nine; the ledger has no ceiling on its accounts)."""
-    p = subprocess.run([sys.executable, "-m", "phsplit", "simulate", "dp-weather", "--vessel", "osv", "--t-end", "4",
+    """The OSV in osv-weather (its own hull's dataset; the fluid memory left out here for speed):
+    its own components and the scenario's waves, wind and current, each booked in its own
+    account. The OSV in dp-weather, whose dataset is the paper box's, is refused: the dataset's
+    hydrostatics are not the OSV's."""
+    from phsplit import scenario as scenario_mod
+
+    text = (Path(scenario_mod.SHIPPED_DIR) / "osv-weather.toml").read_text()
+    text = text.replace("fluid_memory = true", "fluid_memory = false")
+    text = text.replace('hydro = "osv_capytaine.nc"',
+                        f'hydro = "{(Path(scenario_mod.SHIPPED_DIR) / "osv_capytaine.nc").as_posix()}"')
+    sc = tmp_path / "osv-sea.toml"
+    sc.write_text(text)
+    p = subprocess.run([sys.executable, "-m", "phsplit", "simulate", str(sc), "--vessel", "osv", "--t-end", "4",
                         "--out", str(tmp_path / "out"), "--no-plot"], capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, p.stderr
-    nc = tmp_path / "out" / "dp-weather-osv-t4.nc"
-    assert {"crossflow_drag", "current", "waves", "wind"} <= set(_components(nc))
+    nc = tmp_path / "out" / "osv-weather-osv-t4.nc"
+    assert {"crossflow_drag", "roll_damping", "current", "waves", "wind"} <= set(_components(nc))
     ledger = next(line for line in p.stdout.splitlines() if line.startswith("ledger, J:"))
-    for a in ("crossflow_drag", "crossflow_current", "current", "waves", "wave_drift", "wind"):
+    for a in ("crossflow_drag", "crossflow_current", "roll_damping", "current", "waves", "wave_drift", "wind"):
         assert f" {a} " in ledger, ledger
+    p = subprocess.run([sys.executable, "-m", "phsplit", "simulate", "dp-weather", "--vessel", "osv", "--t-end", "4",
+                        "--out", str(tmp_path / "out2"), "--no-plot"], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 2 and "vessel: the dataset's displacement" in p.stderr, p.stderr
+    assert len(p.stderr.strip().splitlines()) == 1 and not (tmp_path / "out2").exists()
 
 
 # ----------------------------------------------------------------------------------------------

@@ -198,7 +198,12 @@ def test_a_scenario_with_an_environment(tmp_path, capsys):
                   '[environment.current]\nvelocity = [0.3, 0.0, 0.0]\n\n'
                   '[environment.waves]\nhs = 2.0\ntp = 8.0\ndirection = 180.0\nseed = 4\ncomponents = 50\n'
                   'omega_range = [0.35, 1.9]\nhydro = "barge.nc"\nsymmetric = true\n')
-    loaded = phsplit.load_scenario(str(sc))
+    # the test barge is not the paper's hull: refused against the vessel's hydrostatics, unless asked
+    with pytest.raises(phsplit.InvalidInputError, match=r"environment.waves.hydro: .*vessel: the dataset's displacement"):
+        phsplit.load_scenario(str(sc))
+    sc.write_text(sc.read_text() + 'hydro_checks = "warn"\n')
+    with pytest.warns(phsplit.hydro.HydroDataWarning, match="vessel: the dataset's"):
+        loaded = phsplit.load_scenario(str(sc))
     assert loaded.vessel.components[-2:] == ["current", "waves"]
     assert main(["simulate", str(sc), "--out", str(tmp_path), "--no-plot"]) == 0
     out = capsys.readouterr().out
@@ -318,3 +323,22 @@ def test_symmetric_must_be_a_boolean(tmp_path):
         phsplit.load_scenario(str(sc))
     with pytest.raises(phsplit.InvalidInputError, match="omega must lie within"):
         hydro.from_capytaine(DATA, omega=5.0)
+
+
+def test_the_default_spectral_range_stays_inside_the_dataset():
+    """Without omega_range, a sea on a dataset takes [0.5, 3] omega_p within the dataset's
+    frequencies: Tp = 6 s (3 omega_p = 3.14 rad/s) on the box's 0.2-2 rad/s runs, its
+    components inside, and Hs is that of the range; a sea wholly outside is refused naming
+    omega_range."""
+    from phsplit import scenario
+
+    d = scenario._read_toml(scenario.resolve("dp-weather"), "scenario file")
+    d["environment"]["waves"].pop("omega_range")
+    d["environment"]["waves"]["tp"] = 6.0
+    w = scenario.from_dict(d, scenario.resolve("dp-weather")).vessel.to_dict()["waves"]
+    assert 0.5 * 2 * np.pi / 6.0 <= min(w["frequencies"]) and max(w["frequencies"]) <= 2.0
+    a = np.asarray(w["amplitudes"])
+    assert abs(4.0 * np.sqrt(np.sum(a ** 2) / 2.0) - 3.0) < 0.15   # Hs = 4 sqrt(m0) of the realisation
+    d["environment"]["waves"]["tp"] = 1.5
+    with pytest.raises(phsplit.InvalidInputError, match=r"environment.waves: the spectrum's range .* give omega_range"):
+        scenario.from_dict(d, scenario.resolve("dp-weather"))

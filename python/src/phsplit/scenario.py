@@ -52,6 +52,7 @@ settings and the vessel, and names a key nobody reads, with the nearest valid on
 from __future__ import annotations
 
 import copy
+import dataclasses
 import difflib
 import math
 import os
@@ -181,7 +182,8 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
         if isinstance(over.get(table), Mapping):
             over[table] = in_radians(dict(over[table]), table, key, path)
     if "environment" in data:
-        env_tables = _environment(data["environment"], path, base_dir)
+        hull = overlay(base.to_dict(), {"vessel": over["vessel"]} if "vessel" in over else {})
+        env_tables = _environment(data["environment"], path, base_dir, hull)
         if "port_hamiltonian" in env_tables and ("port_hamiltonian" in over or "port_hamiltonian" in base.to_dict()):
             raise _core.InvalidInputError(f"{path}: environment.waves.fluid_memory: the vessel already has a "
                                           f"port-Hamiltonian subsystem, and a vessel holds one")
@@ -253,7 +255,7 @@ def resolve(path: str | os.PathLike[str]) -> str:
     return p
 
 
-def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
+def _environment(env: Any, path: str, base_dir: str, vessel: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The vessel tables an ``[environment]`` table stands for: ``[environment.current]`` is the
     ``[current]`` component; ``[environment.wind]`` a wind (``phsplit.sea.Wind``: speed,
     direction, gust spectrum, seed), realised into the ``[wind]`` component, whose windage and
@@ -264,7 +266,9 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
     a physics check with a warning instead of refusing it, docs/hydrodynamic-data.md) or from the
     vessel file's own ``[waves]`` keys; ``fluid_memory = true`` adds the dataset's Cummins fluid
     memory (``phsplit.radiation``: the ``[port_hamiltonian]`` table ``radiation`` and ``A∞`` as
-    ``vessel.added_mass``; docs/explanation/components/fluid-memory.md)."""
+    ``vessel.added_mass``; docs/explanation/components/fluid-memory.md). ``vessel``: the tables
+    of the vessel the scenario runs, whose centre of gravity places the dataset's loads at its
+    body origin and whose hydrostatics the dataset must match (``phsplit.hydro.from_capytaine``)."""
     if not isinstance(env, Mapping):
         raise _core.ScenarioParseError(f"{path}: [environment] must be a table")
     allowed = ("current", "waves", "wind")
@@ -282,7 +286,7 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
     if "waves" in env:
         w = dict(env["waves"])
         try:
-            comps = sea.sea_state(w).realise()
+            state = sea.sea_state(w)
         except (_core.ScenarioParseError, _core.InvalidInputError) as e:
             raise type(e)(f"{path}: {e}") from None
         table: dict[str, Any] = {}
@@ -301,9 +305,21 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
                 raise _core.ScenarioParseError(f"{path}: environment.waves.hydro_checks must be one of "
                                                f"{', '.join(map(repr, hydro.CHECK_MODES))}, got {checks!r}")
             try:
-                table = hydro.from_capytaine(p, symmetric=sym, checks=checks)["waves"]
+                table = hydro.from_capytaine(p, symmetric=sym, checks=checks, vessel=vessel)["waves"]
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
+            if state.omega_range is None:
+                # the default range, [0.5, 3] omega_p, within the dataset's frequencies
+                lo, hi = state.range()
+                f = table["rao_frequencies"]
+                lo, hi = max(lo, float(f[0])), min(hi, float(f[-1]))
+                if not lo < hi:
+                    raise _core.InvalidInputError(
+                        f"{path}: environment.waves: the spectrum's range [0.5, 3] omega_p = "
+                        f"[{state.range()[0]:.3g}, {state.range()[1]:.3g}] rad/s lies outside the dataset's "
+                        f"{float(f[0]):g}-{float(f[-1]):g} rad/s: give omega_range, or a dataset that covers tp = {state.tp:g} s")
+                state = dataclasses.replace(state, omega_range=(lo, hi))
+            comps = state.realise()
             outside = _outside_directions(table.get("rao_directions", []), comps.get("directions", []))
             if outside is not None:
                 raise _core.InvalidInputError(
@@ -322,11 +338,13 @@ def _environment(env: Any, path: str, base_dir: str) -> dict[str, Any]:
             from . import radiation
 
             try:
-                fm = radiation.fluid_memory(p, symmetric=sym, checks=checks)
+                fm = radiation.fluid_memory(p, symmetric=sym, checks=checks, vessel=vessel)
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.fluid_memory: {e}") from None
             out["port_hamiltonian"] = fm.table
             out["vessel"] = {"added_mass": fm.added_mass_infinite.tolist()}
+        if "hydro" not in w:
+            comps = state.realise()
         out["waves"] = {**table, **comps}
     if "wind" in env:
         try:

@@ -31,7 +31,8 @@ DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 #: The shipped box of the paper's vessel (dp-weather's dataset).
 DEFAULT_DATASET = os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios", "paper_box_capytaine.nc")
 #: The shipped Capytaine dataset of each shipped vessel that has one (``phsplit rao``'s default).
-DATASETS = {"paper": DEFAULT_DATASET}
+DATASETS = {"paper": DEFAULT_DATASET,
+            "osv": os.path.join(os.path.dirname(os.path.abspath(__file__)), "scenarios", "osv_capytaine.nc")}
 _UNITS = {"surge": "m m-1", "sway": "m m-1", "heave": "m m-1", "roll": "rad m-1", "pitch": "rad m-1", "yaw": "rad m-1"}
 
 
