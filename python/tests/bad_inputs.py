@@ -1168,3 +1168,33 @@ CATALOGUE += [
     Bad("CLI: RAO of a vessel without a shipped dataset", cli("rao", "--vessel", "supply", "--no-plot"), C,
         ("--vessel supply", "no shipped dataset", "--dataset")),
 ]
+
+
+def _rao_call(**kw) -> Callable[[], object]:
+    def call():
+        args = {"frequencies": [0.56], "heading": 90.0} | kw
+        return phsplit.rao(phsplit.Vessel.paper(), args.pop("frequencies"), args.pop("heading"), **args)
+    return call
+
+
+CATALOGUE += [
+    Bad("RAO at a frequency given as a string", _rao_call(frequencies=["0.56"]), E, ("frequencies must be positive numbers",)),
+    Bad("RAO with a boolean amplitude", _rao_call(amplitude=True), E, ("amplitude must be a positive number",)),
+    Bad("RAO heading given as a string", _rao_call(heading="90"), E, ("heading must be a number",)),
+    Bad("RAO heading beyond a turn", _rao_call(heading=720.0), E, ("heading", "±360")),
+    Bad("RAO at a frequency twice", _rao_call(frequencies=[0.56, 0.56]), E, ("frequencies must be distinct",)),
+    Bad("RAO with dofs None", _rao_call(dofs=None), E, ("dofs must be distinct names",)),
+    Bad("RAO with a step that cannot follow the wave", _rao_call(h=100.0, t_end=300.0), E,
+        ("h = 100 s cannot follow the wave", "a quarter of its period")),
+    Bad("RAO with a step so short the runs never end", _rao_call(h=1e-6, t_end=300.0), E, ("steps per frequency", "2e6")),
+    Bad("RAO fitted over a tenth of a period", _rao_call(periods=0.1), E, ("periods must be at least 1",)),
+    Bad("RAO with check_only as a string", _rao_call(check_only="no"), E, ("check_only must be True or False",)),
+    Bad("CLI: RAO at the same heading twice", cli("rao", "--headings", "90", "90", "--no-plot"), C,
+        ("--headings must be distinct",)),
+    Bad("CLI: capability at a step of a nanodegree", cli("capability", "dp-capability", "--step", "1e-9", "--no-plot"), C,
+        ("--step must be at least 0.1 degrees",)),
+    Bad("CLI: capability with both directions and a step",
+        cli("capability", "dp-capability", "--directions", "0", "90", "--step", "7", "--no-plot"), C,
+        ("either --directions or --step",)),
+    Bad("port-Hamiltonian name of 300 letters", _ph_dict(name="a" * 300), E, ("port_hamiltonian.name", "at most 64")),
+]

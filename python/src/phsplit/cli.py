@@ -743,9 +743,11 @@ def _capability(args) -> int:
     from . import scenario as scn
     from .capability import capability, polar_plot
 
+    if args.directions is not None and "--step" in args.argv:
+        raise UsageError("give either --directions or --step, not both")
     if args.directions is None:
-        if not (args.step > 0 and args.step <= 180 and (360.0 / args.step) == round(360.0 / args.step)):
-            raise UsageError(f"--step must divide 360 degrees (e.g. 5, 10, 15), got {args.step:g}")
+        if not (args.step >= 0.1 and args.step > 0 and args.step <= 180 and (360.0 / args.step) == round(360.0 / args.step)):
+            raise UsageError(f"--step must be at least 0.1 degrees and divide 360 (e.g. 5, 10, 15), got {args.step:g}")
         directions = _angles(args.step)
     else:
         directions = args.directions
@@ -843,6 +845,8 @@ def _rao(args) -> int:
         w = data[0]
         freqs = [float(x) for x in w if 0.3 - 1e-9 <= x <= 1.9 + 1e-9]
     # every argument checked (by a run-free call per heading) before the first run
+    if len(set(args.headings)) != len(args.headings):
+        raise UsageError(f"--headings must be distinct, got {' '.join(f'{x:g}' for x in args.headings)}")
     for hd in args.headings:
         seakeeping.rao(vessel, freqs, hd, tuple(args.dofs), amplitude=args.amplitude, dataset=dataset,
                        fluid_memory=not args.no_fluid_memory, h=args.h, t_end=args.t_end, check_only=True)

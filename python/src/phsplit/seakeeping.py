@@ -188,6 +188,8 @@ def time_rao(vessel, waves, omega: float, heading: float, *, amplitude: float = 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", SettingWarning)
         s = simulate(v, (0.0, t_end), h, method, control_start=None, initial=y0, save_every=1)
+    if s.status == "interrupted":   # Ctrl-C or SIGTERM: the caller's to handle, as for simulate
+        raise KeyboardInterrupt
     if s.status != "completed":
         raise _core.IntegrationError(f"the run at {omega:g} rad/s did not complete: {s.failure}")
     keep = s.t >= t_end - periods * 2 * math.pi / omega - 1e-9
@@ -218,14 +220,15 @@ def drift(s, omega: float, periods: float) -> float:
 DRIFT_FRACTION = 0.02
 
 
+def _real(x) -> bool:
+    """A real number, not a bool, a string or anything else float() would take."""
+    return isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, (bool, np.bool_))
+
+
 def _positive(name, x):
-    try:
-        x = float(x)
-    except (TypeError, ValueError):
-        raise _err(f"{name} must be a positive number, got {x!r}") from None
-    if not (math.isfinite(x) and x > 0):
+    if not (_real(x) and math.isfinite(float(x)) and float(x) > 0):
         raise _err(f"{name} must be a positive number, got {x!r}")
-    return x
+    return float(x)
 
 
 def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *, amplitude: float = 0.1,
@@ -261,20 +264,23 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
 
     if not isinstance(vessel, Vessel):
         raise _err(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
-    try:
-        freqs = np.atleast_1d(np.asarray(frequencies, dtype=float))
-    except (TypeError, ValueError):
-        raise _err(f"frequencies must be positive numbers (rad/s), got {frequencies!r}") from None
+    items = list(frequencies) if isinstance(frequencies, (list, tuple, np.ndarray)) else [frequencies]
+    if not all(_real(x) for x in np.ravel(np.asarray(items, dtype=object))):
+        raise _err(f"frequencies must be positive numbers (rad/s), got {frequencies!r}")
+    freqs = np.atleast_1d(np.asarray(items, dtype=float))
     if freqs.ndim != 1 or freqs.size == 0 or not np.all(np.isfinite(freqs)) or np.any(freqs <= 0):
         raise _err(f"frequencies must be a non-empty list of positive numbers (rad/s), got {frequencies!r}")
-    try:
-        heading = float(heading)
-    except (TypeError, ValueError):
-        raise _err(f"heading must be a number (degrees), got {heading!r}") from None
-    if not math.isfinite(heading):
-        raise _err(f"heading must be a finite number (degrees), got {heading!r}")
+    if len(np.unique(freqs)) != len(freqs):
+        raise _err(f"frequencies must be distinct, got {frequencies!r}")
+    if not _real(heading):
+        raise _err(f"heading must be a number (degrees), got {heading!r}")
+    heading = float(heading)
+    if not (math.isfinite(heading) and -360.0 <= heading <= 360.0):
+        raise _err(f"heading must be a number of degrees within ±360, got {heading!r}")
     if isinstance(dofs, str):
         dofs = (dofs,)
+    if not isinstance(dofs, (list, tuple)):
+        raise _err(f"dofs must be distinct names of {', '.join(DOFS)}, got {dofs!r}")
     dofs = tuple(dofs)
     bad = [d for d in dofs if d not in DOFS]
     if not dofs or bad or len(set(dofs)) != len(dofs):
@@ -283,6 +289,16 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
     h = _positive("h", h)
     t_end = _positive("t_end", t_end)
     periods = _positive("periods", periods)
+    if periods < 1.0:
+        raise _err(f"periods must be at least 1 (the fit window, in periods of the lowest frequency), got {periods:g}")
+    shortest = 2 * math.pi / float(freqs.max())
+    if h > shortest / 4:
+        raise _err(f"h = {h:g} s cannot follow the wave of {float(freqs.max()):g} rad/s (period {shortest:.4g} s): "
+                   f"take h <= {shortest / 4:.3g} s, a quarter of its period")
+    if t_end / h > 2_000_000:
+        raise _err(f"t_end / h = {t_end / h:.3g} steps per frequency; at most 2e6 (take a longer h or a shorter t_end)")
+    if not isinstance(check_only, bool):
+        raise _err(f"check_only must be True or False, got {check_only!r}")
     window = periods * 2 * math.pi / float(freqs.min())
     if t_end < 2 * window:
         raise _err(f"t_end must be at least twice the fit window ({periods:g} periods of the lowest frequency, "

@@ -106,9 +106,12 @@ fn strings(p: &mut Params, key: &str, what: &str) -> crate::Result<Option<Vec<St
     Ok(Some(out))
 }
 
+/// Letters, digits and underscores, starting with a letter, at most 64 characters (the names
+/// of the outputs built from it, `<name>_<state>`, stay within NetCDF's 256).
 fn is_name(s: &str) -> bool {
     let mut c = s.chars();
-    c.next().is_some_and(|f| f.is_ascii_alphabetic())
+    s.len() <= 64
+        && c.next().is_some_and(|f| f.is_ascii_alphabetic())
         && s.chars().all(|x| x.is_ascii_alphanumeric() || x == '_')
 }
 
@@ -210,7 +213,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         Some(toml::Value::String(s)) if is_name(&s) => s,
         Some(v) => {
             return Err(Error::InvalidInput(format!(
-                "{T}.name must be a name of letters, digits and underscores that starts with a letter (it names the subsystem's account and outputs), got {v}"
+                "{T}.name must be a name of at most 64 letters, digits and underscores that starts with a letter (it names the subsystem's account and outputs), got {v}"
             )))
         }
     };
@@ -226,7 +229,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     for (i, s) in states.iter().enumerate() {
         if !is_name(s) {
             return Err(Error::InvalidInput(format!(
-                "{T}.states[{i}] must be a name of letters, digits and underscores that starts with a letter, got {s:?}"
+                "{T}.states[{i}] must be a name of at most 64 letters, digits and underscores that starts with a letter, got {s:?}"
             )));
         }
         if states[..i].contains(s) {
