@@ -65,6 +65,23 @@ HULLS = {
 THETA = np.linspace(-np.pi / 6, 2 * np.pi + np.pi / 6, 121)
 
 
+def slim(cpt, ds):
+    """The dataset as stored: only what phsplit reads or checks (the diffraction part is
+    excitation - Froude-Krylov), complex values as real and imaginary parts, and plain string
+    labels for the DOF coordinates (Capytaine keeps them categorical in memory)."""
+    ds = ds.drop_vars([v for v in ("kochin_diffraction", "kochin_radiation", "kochin", "diffraction_force")
+                       if v in ds.variables], errors="ignore")
+    ds = ds.drop_dims("theta", errors="ignore")
+    for c in ("freq", "period", "wavelength"):
+        if c in ds.coords:
+            ds = ds.drop_vars(c)
+    ds = cpt.io.xarray.separate_complex_values(ds)
+    for c in list(ds.coords):
+        if str(ds[c].dtype) == "category" or "Categorical" in type(ds[c].dtype).__name__:
+            ds = ds.assign_coords({c: [str(v) for v in ds[c].values]})
+    return ds
+
+
 def main(out: str, name: str) -> None:
     import capytaine as cpt
     import xarray as xr
@@ -117,18 +134,7 @@ def main(out: str, name: str) -> None:
     ds["added_mass_infinite_frequency"].attrs = {"long_name": "added mass at infinite frequency (Capytaine, omega = inf)"}
     ds["waterplane_area"] = xr.DataArray(float(hs["waterplane_area"]), attrs={"units": "m^2"})
     ds["disp_volume"] = xr.DataArray(float(hs["disp_volume"]), attrs={"units": "m^3"})
-    # Only what phsplit reads or checks is kept: the diffraction part is excitation - Froude-Krylov.
-    ds = ds.drop_vars([v for v in ("kochin_diffraction", "kochin_radiation", "kochin", "diffraction_force")
-                       if v in ds.variables], errors="ignore")
-    ds = ds.drop_dims("theta", errors="ignore")
-    for c in ("freq", "period", "wavelength"):
-        if c in ds.coords:
-            ds = ds.drop_vars(c)
-    ds = cpt.io.xarray.separate_complex_values(ds)
-    # Plain string labels for the DOF coordinates (Capytaine keeps them categorical in memory).
-    for c in list(ds.coords):
-        if str(ds[c].dtype) == "category" or "Categorical" in type(ds[c].dtype).__name__:
-            ds = ds.assign_coords({c: [str(v) for v in ds[c].values]})
+    ds = slim(cpt, ds)
     rc = np.asarray(rotation_center, dtype=float)
     ds.attrs.update({
         "phsplit_note": f"{label}; made by scripts/gen_capytaine_box.py",

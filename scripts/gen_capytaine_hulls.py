@@ -79,7 +79,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_capytaine_box import G, RHO, THETA  # noqa: E402  (the box script's constants)
+from gen_capytaine_box import G, RHO, THETA, slim  # noqa: E402  (the box script's constants and storage)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, "..")
@@ -354,16 +354,7 @@ def main(name: str = "osv") -> None:
     rao = cpt.post_pro.rao(ds, dissipation=dof_matrix(xr, D, dofs))
     write_rao(cpt, xr, ds, rao, h, M, D, name)
 
-    ds = ds.drop_vars([v for v in ("kochin_diffraction", "kochin_radiation", "kochin", "diffraction_force")
-                       if v in ds.variables], errors="ignore")
-    ds = ds.drop_dims("theta", errors="ignore")
-    for c in ("freq", "period", "wavelength"):
-        if c in ds.coords:
-            ds = ds.drop_vars(c)
-    ds = cpt.io.xarray.separate_complex_values(ds)
-    for c in list(ds.coords):
-        if str(ds[c].dtype) == "category" or "Categorical" in type(ds[c].dtype).__name__:
-            ds = ds.assign_coords({c: [str(v) for v in ds[c].values]})
+    ds = slim(cpt, ds)
     cg = h["cg"]
     ds.attrs.update({
         "phsplit_note": f"{h['label']}; made by scripts/gen_capytaine_hulls.py (its docstring: the hull and its sources)",

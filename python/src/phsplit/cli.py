@@ -8,6 +8,15 @@ import sys
 import tempfile
 import time
 
+def _check_out_folder(out: str) -> None:
+    """``--out`` names a folder that is there or can be made, checked before anything runs."""
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise UsageError(f"--out {out!r} is a file, not a folder")
+    parent, ok = _writable_ancestor(out)
+    if not ok:
+        raise UsageError(f"cannot write into --out {out!r}: {parent!r} is not a writable folder")
+
+
 def _writable_ancestor(path: str) -> tuple[str, bool]:
     """The nearest existing folder of ``path`` (itself if it exists) and whether a file or
     folder can be made in it: what an output that is not yet there needs."""
@@ -762,11 +771,7 @@ def _capability(args) -> int:
     out = args.out
     # Every check of the output before the analysis runs (it may take minutes); the folder
     # itself is made only once there is something to write into it.
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise UsageError(f"--out {out!r} is a file, not a folder")
-    parent, ok = _writable_ancestor(out)
-    if not ok:
-        raise UsageError(f"cannot write into --out {out!r}: {parent!r} is not a writable folder")
+    _check_out_folder(out)
     stem = os.path.join(out, f"{sc.name}-capability")
     nc, png = stem + ".nc", stem + ".png"
     for f in (nc,) if args.no_plot else (nc, png):
@@ -830,11 +835,7 @@ def _rao(args) -> int:
     elif not os.path.isfile(dataset):
         raise UsageError(f"--dataset {dataset!r} is not a file")
     out = args.out
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise UsageError(f"--out {out!r} is a file, not a folder")
-    parent, ok = _writable_ancestor(out)
-    if not ok:
-        raise UsageError(f"cannot write into --out {out!r}: {parent!r} is not a writable folder")
+    _check_out_folder(out)
     nc, png = os.path.join(out, f"{name}-rao.nc"), os.path.join(out, f"{name}-rao.png")
     for f in (nc,) if args.no_plot else (nc, png):
         if os.path.isdir(f):
