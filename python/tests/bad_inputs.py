@@ -1198,3 +1198,28 @@ CATALOGUE += [
         ("either --directions or --step",)),
     Bad("port-Hamiltonian name of 300 letters", _ph_dict(name="a" * 300), E, ("port_hamiltonian.name", "at most 64")),
 ]
+
+
+CATALOGUE += [
+    Bad("fluid memory on a vessel with an added mass of its own", lambda: phsplit.radiation.with_fluid_memory(
+        phsplit.Vessel.from_dict({**phsplit.Vessel.paper().to_dict(), "vessel": {
+            **phsplit.Vessel.paper().to_dict()["vessel"], "added_mass": [[1e5 if i == j else 0.0 for j in range(6)]
+                                                                          for i in range(6)]}}),
+        phsplit.seakeeping.DEFAULT_DATASET), E, ("vessel.added_mass", "infinite-frequency added mass")),
+    Bad("fluid memory with an unknown keyword", lambda: phsplit.radiation.with_fluid_memory(
+        phsplit.Vessel.paper(), phsplit.seakeeping.DEFAULT_DATASET, bogus=3), E, ("unknown keyword 'bogus'",)),
+    Bad("roll damping of 1e300", vessel_with("[control]", "[roll_damping]\nlinear = 1e300\n\n[control]"), E,
+        ("roll_damping.linear must be at most",)),
+    Bad("motion statistics after a string", lambda: phsplit.simulate(phsplit.Vessel.paper(), (0.0, 2.0), 0.5, "sp2")
+        .motion_statistics(after="5"), E, ("after must be a time in seconds",)),
+    Bad("driving a pipe of no vessel", lambda: phsplit.pipe.drive(None, [0.0, 1.0], [[0.0, 0.0, -10.0]] * 2), E,
+        ("vessel must be a phsplit.Vessel",)),
+    Bad("driving a pipe over no times", lambda: phsplit.pipe.drive(phsplit.Vessel.paper(), [], []), E,
+        ("times must be at least two",)),
+    Bad("scenario waves with symmetric but no dataset",
+        scenario("[simulation]\nt_span = [0.0, 1.0]\n[environment.waves]\nhs = 1.0\ntp = 8.0\nsymmetric = true\n"), P,
+        ("environment.waves.symmetric", "needs environment.waves.hydro")),
+    Bad("scenario waves with no transfer functions",
+        scenario("[simulation]\nt_span = [0.0, 1.0]\n[environment.waves]\nhs = 1.0\ntp = 8.0\n"), E,
+        ("environment.waves needs the hull's transfer functions",)),
+]

@@ -29,9 +29,24 @@ def drive(vessel, times, tops) -> dict[str, np.ndarray]:
     line at its top), ``drag``, ``axial_damping``, ``seabed`` (dissipated) and ``current``
     (supplied), J; and ``nodes`` (the positions at the end, m, shape (N + 1, 3)). The energy
     closes: ``diff(storage) == top_work + current - drag - axial_damping - seabed``."""
-    inner = getattr(vessel, "_inner", vessel)
-    out = _core.drive_pipe(inner, np.ascontiguousarray(times, dtype=np.float64),
-                           np.ascontiguousarray(tops, dtype=np.float64))
+    from .vessel import Vessel
+
+    if not isinstance(vessel, Vessel):
+        raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel with a dynamic pipe, got {type(vessel).__name__}")
+    try:
+        t = np.ascontiguousarray(times, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError(f"times must be increasing numbers (s), got {times!r}") from None
+    try:
+        x = np.ascontiguousarray(tops, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise _core.InvalidInputError(f"tops must be one row of 3 numbers (m, spatial) per time, got {tops!r}") from None
+    if t.ndim != 1 or t.size < 2:
+        raise _core.InvalidInputError(f"times must be at least two increasing numbers (s), got {times!r}")
+    if x.ndim != 2 or x.shape != (t.size, 3):
+        raise _core.InvalidInputError(f"tops must be one row of 3 numbers (m, spatial) per time: {t.size} rows, "
+                                      f"got shape {x.shape}")
+    out = _core.drive_pipe(vessel._inner, t, x)
     return {k: np.asarray(v, dtype=np.float64) for k, v in out.items()}
 
 

@@ -503,6 +503,19 @@ def fluid_memory(dataset, *, symmetric: bool = True, checks: str = "refuse", ves
     return fm
 
 
+def _added_mass_is_a_models(vessel) -> bool:
+    """Whether the vessel's added mass is a shipped vessel's own (a preset's low-frequency added
+    mass, which the memory's A∞ replaces, as the shipped osv-weather does), not one of the user's."""
+    from .vessel import Vessel, presets
+
+    mine = np.asarray(vessel.to_dict()["vessel"]["added_mass"], float)
+    for name in presets():
+        theirs = Vessel.preset(name).to_dict()["vessel"].get("added_mass")
+        if theirs is not None and np.array_equal(mine, np.asarray(theirs, float)):
+            return True
+    return False
+
+
 def with_fluid_memory(vessel, dataset, *, damping=None, memory: FluidMemory | None = None, symmetric: bool = True,
                       checks: str = "refuse", **fit):
     """The vessel (a ``phsplit.Vessel``) with Cummins' fluid memory of a Capytaine dataset: its
@@ -539,6 +552,14 @@ def with_fluid_memory(vessel, dataset, *, damping=None, memory: FluidMemory | No
                 ok = False
             if not ok:
                 raise _err(f"damping[{k!r}] must be 3 numbers (kg/s or kg m^2/s), got {x!r}")
+    if "added_mass" in d["vessel"] and np.any(np.asarray(d["vessel"]["added_mass"], float) != 0.0) \
+            and not _added_mass_is_a_models(vessel):
+        raise _err("the vessel gives vessel.added_mass, which the fluid memory replaces by the dataset's "
+                   "infinite-frequency added mass: remove it, or start from a shipped vessel")
+    known = {"blocks", "a_inf", "coupling_tolerance", "refine", "name", "rank_tolerance", "starts"}
+    bad = sorted(set(fit) - known)
+    if bad:
+        raise _err(f"with_fluid_memory got an unknown keyword {bad[0]!r} (the fit's keywords: {', '.join(sorted(known))})")
     if memory is None:
         memory = fluid_memory(dataset, symmetric=symmetric, checks=checks, vessel=vessel, **fit)
     elif not isinstance(memory, FluidMemory):
@@ -546,6 +567,13 @@ def with_fluid_memory(vessel, dataset, *, damping=None, memory: FluidMemory | No
     elif fit:
         raise _err(f"memory is an existing fit, so the fit's keywords ({', '.join(sorted(fit))}) would not be used: "
                    f"give them to fluid_memory(), or leave memory out")
+    else:
+        how = "highest" if str(memory.a_inf_source).startswith("the added mass at the highest") else "dataset"
+        ainf = retardation_data(dataset, symmetric=symmetric, checks=checks, vessel=vessel, a_inf=how)[2]
+        if ainf.shape != memory.added_mass_infinite.shape or not np.allclose(
+                memory.added_mass_infinite, ainf, rtol=1e-9, atol=1e-9 * np.abs(ainf).max()):
+            raise _err("memory is the fit of another dataset or vessel (its infinite-frequency added mass is not "
+                       "this dataset's about this vessel's origin): fit it with fluid_memory() of the same ones")
     d["vessel"]["added_mass"] = memory.added_mass_infinite.tolist()
     if damping is not None:
         for k in ("damping_translational", "damping_rotational"):

@@ -344,6 +344,14 @@ def _environment(env: Any, path: str, base_dir: str, vessel: Mapping[str, Any] |
             out["port_hamiltonian"] = fm.table
             out["vessel"] = {"added_mass": fm.added_mass_infinite.tolist()}
         if "hydro" not in w:
+            given = [k for k in ("symmetric", "hydro_checks") if k in w]
+            if given:
+                raise _core.ScenarioParseError(f"{path}: environment.waves.{given[0]} applies to a dataset: it needs "
+                                               f"environment.waves.hydro")
+            if vessel is not None and "rao_frequencies" not in (vessel.get("waves") or {}):
+                raise _core.InvalidInputError(f"{path}: environment.waves needs the hull's transfer functions: "
+                                              f"environment.waves.hydro (a Capytaine dataset) or the vessel's own "
+                                              f"[waves] rao_frequencies, rao_directions, force_rao_real, force_rao_imag")
             comps = state.realise()
         out["waves"] = {**table, **comps}
     if "wind" in env:

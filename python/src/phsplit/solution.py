@@ -205,10 +205,9 @@ class Solution:
         (crest to trough, the analogue of the significant wave height Hs; half of it is the
         significant single amplitude). Sample statistics: the samples should be uniform in time
         (``save_every``, not ``save_at``)."""
-        try:
-            after = float(after)
-        except (TypeError, ValueError):
-            raise _core.InvalidInputError(f"after must be a time in seconds, got {after!r}") from None
+        if isinstance(after, (bool, np.bool_)) or not isinstance(after, (int, float, np.integer, np.floating)):
+            raise _core.InvalidInputError(f"after must be a time in seconds, got {after!r}")
+        after = float(after)
         keep = self.t >= after
         if not np.isfinite(after) or keep.sum() < 2:
             raise _core.InvalidInputError(f"after must leave at least two saved samples (the run saved "

@@ -50,7 +50,12 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
         return Ok(None);
     }
     let linear = p.opt_f64(T, "linear", "N m s", Range::NonNegative)?;
-    let zeta = p.opt_f64(T, "critical_fraction", "1", Range::NonNegative)?;
+    let zeta = p.opt_f64(
+        T,
+        "critical_fraction",
+        "a fraction of critical damping, in [0, 1)",
+        Range::NonNegative,
+    )?;
     let quadratic = p
         .opt_f64(T, "quadratic", "N m s^2", Range::NonNegative)?
         .unwrap_or(0.0);
@@ -71,6 +76,15 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
         }
         (None, None) => 0.0,
     };
+    // Far above any hull's (a 300 m ship's critical roll damping is about 1e11 N m s): a slip of
+    // units or digits, refused before it stalls the run.
+    for (key, v, max) in [("linear", linear, 1e14), ("quadratic", quadratic, 1e16)] {
+        if v > max {
+            return Err(Error::InvalidInput(format!(
+                "roll_damping.{key} must be at most {max:e} (N m s or N m s^2; a large ship's critical roll damping is about 1e11 N m s), got {v:e}"
+            )));
+        }
+    }
     if linear == 0.0 && quadratic == 0.0 {
         return Err(Error::InvalidInput(
             "[roll_damping] needs linear (N m s) or critical_fraction (0 <= zeta < 1), and/or quadratic (N m s^2), one of them > 0".into(),
