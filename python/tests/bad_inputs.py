@@ -1223,3 +1223,20 @@ CATALOGUE += [
         scenario("[simulation]\nt_span = [0.0, 1.0]\n[environment.waves]\nhs = 1.0\ntp = 8.0\n"), E,
         ("environment.waves needs the hull's transfer functions",)),
 ]
+
+
+CATALOGUE += [
+    Bad("event whose condition fails later in the run", lambda: phsplit.simulate(
+        phsplit.Vessel.paper(), (0.0, 5.0), 0.5, "sp2",
+        events=[phsplit.events.Event("late", lambda t, y, v: 1.0 if t < 1.0 else 1.0 / 0.0)]), E,
+        ("event 'late'", "raised ZeroDivisionError at t =")),
+]
+
+
+CATALOGUE += [
+    Bad("scenario sea whose omega_range reaches past its dataset", scenario(
+        open(phsplit.scenario.resolve("dp-weather")).read().replace(
+            "omega_range = [0.35, 2.0]", "omega_range = [0.05, 5.0]").replace(
+            'hydro = "paper_box_capytaine.nc"', f'hydro = "{phsplit.seakeeping.DEFAULT_DATASET}"')), E,
+        ("environment.waves.omega_range = [0.05, 5]", "outside the dataset's 0.2-2 rad/s")),
+]

@@ -71,6 +71,15 @@ class Event:
         if not callable(self.g):
             raise _core.InvalidInputError(f"event {self.name!r}: g must be callable g(t, y, vessel)")
 
+    def value(self, t: float, y, vessel) -> float:
+        """``g(t, y, vessel)`` as a float; an exception raised by ``g`` during a run becomes one
+        line naming the event and the time."""
+        try:
+            return float(self.g(t, y, vessel))
+        except Exception as e:  # the user's function: any failure of it is theirs to see named
+            raise _core.InvalidInputError(f"event {self.name!r}: g(t, y, vessel) raised {type(e).__name__} at "
+                                          f"t = {t:g} s: {e}") from None
+
     def crosses(self, g0: float, g1: float) -> bool:
         if not (math.isfinite(g0) and math.isfinite(g1)):
             return False
@@ -300,7 +309,7 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                 ya, yb = g.state(i - 1), g.state(i)
                 found = []
                 for ev in events:
-                    if ev.crosses(ev.g(float(g.t[i - 1]), ya, vessel), ev.g(float(g.t[i]), yb, vessel)):
+                    if ev.crosses(ev.value(float(g.t[i - 1]), ya, vessel), ev.value(float(g.t[i]), yb, vessel)):
                         found.append((*_locate(vessel, settings, ev, float(g.t[i - 1]), ya,
                                                float(g.t[i]) - float(g.t[i - 1]), names), ev))
                 found.sort(key=lambda f: f[0])
@@ -336,7 +345,7 @@ def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, 
 
     lo, hi = 0.0, h
     best = at(h)
-    g_lo, g_hi = ev.g(t_a, y_a, vessel), ev.g(t_a + h, best.state(-1), vessel)
+    g_lo, g_hi = ev.value(t_a, y_a, vessel), ev.value(t_a + h, best.state(-1), vessel)
     side = 0
     # The shortest partial step the times of the run resolve (the core refuses shorter ones).
     tol = max(1e-12, 1024.0 * np.finfo(float).eps * max(1.0, abs(t_a) + h))
@@ -348,7 +357,7 @@ def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, 
             tau = 0.5 * (lo + hi)
         tau = min(max(tau, tol), h)
         s = at(tau)
-        g = ev.g(t_a + tau, s.state(-1), vessel)
+        g = ev.value(t_a + tau, s.state(-1), vessel)
         if ev.crosses(g_lo, g):  # the crossing is in [lo, tau]
             hi, g_hi, best = tau, g, s
             if side == 1:

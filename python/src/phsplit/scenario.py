@@ -308,6 +308,13 @@ def _environment(env: Any, path: str, base_dir: str, vessel: Mapping[str, Any] |
                 table = hydro.from_capytaine(p, symmetric=sym, checks=checks, vessel=vessel)["waves"]
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
+            f = table["rao_frequencies"]
+            if state.omega_range is not None and not (float(f[0]) - 1e-9 <= state.range()[0]
+                                                      and state.range()[1] <= float(f[-1]) + 1e-9):
+                raise _core.InvalidInputError(
+                    f"{path}: environment.waves.omega_range = [{state.range()[0]:g}, {state.range()[1]:g}] rad/s "
+                    f"reaches outside the dataset's {float(f[0]):g}-{float(f[-1]):g} rad/s (its transfer functions are "
+                    f"not extrapolated): give a range inside it, or leave omega_range out for the default within it")
             if state.omega_range is None:
                 # the default range, [0.5, 3] omega_p, within the dataset's frequencies
                 lo, hi = state.range()
