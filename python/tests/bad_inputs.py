@@ -1240,3 +1240,15 @@ CATALOGUE += [
             'hydro = "paper_box_capytaine.nc"', f'hydro = "{phsplit.seakeeping.DEFAULT_DATASET}"')), E,
         ("environment.waves.omega_range = [0.05, 5]", "outside the dataset's 0.2-2 rad/s")),
 ]
+
+
+CATALOGUE += [
+    Bad("two events of the same name", lambda: phsplit.simulate(
+        phsplit.Vessel.paper(), (0.0, 5.0), 0.5, "sp2",
+        events=[phsplit.events.roll_beyond(30.0), phsplit.events.roll_beyond(30.0)]), E, ("named", "twice")),
+    Bad("save_at together with save_every", lambda: phsplit.simulate(
+        phsplit.Vessel.paper(), (0.0, 5.0), 0.5, "sp2", save_at=[1.0, 2.0], save_every=2), E,
+        ("save_at", "save_every = 2 would not be used")),
+    Bad("sea seed beyond 2^63", lambda: phsplit.sea.SeaState(hs=2.0, tp=9.0, seed=2 ** 70), E,
+        ("seed must be an integer in [0, 2^63)",)),
+]

@@ -240,6 +240,11 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
     for ev in events:
         if not isinstance(ev, Event):
             raise _core.InvalidInputError(f"events must be phsplit.events.Event objects, got {type(ev).__name__}")
+    names = [ev.name for ev in events]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise _core.InvalidInputError(f"events are named {twice[0]!r} twice; each event needs its own name "
+                                      f"(the hits are reported by name)")
     if save_at is not None and events:
         raise _core.InvalidInputError("give save_at or events, not both: events end or mark the run on its own "
                                       "saved states (save_every); save_at then has nothing to add")

@@ -135,8 +135,8 @@ class SeaState:
         if not (isinstance(self.components, int) and not isinstance(self.components, bool)
                 and 1 <= self.components <= 10_000):
             bad(f"components must be an integer in [1, 10000], got {self.components!r}")
-        if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0):
-            bad(f"seed must be an integer >= 0, got {self.seed!r}")
+        if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and 0 <= self.seed < 2 ** 63):
+            bad(f"seed must be an integer in [0, 2^63), got {self.seed!r}")
         if self.omega_range is not None:
             _check_range("waves", self.omega_range)
 
@@ -284,8 +284,8 @@ class Wind:
         if not (isinstance(self.components, int) and not isinstance(self.components, bool)
                 and 1 <= self.components <= 10_000):
             bad(f"components must be an integer in [1, 10000], got {self.components!r}")
-        if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0):
-            bad(f"seed must be an integer >= 0, got {self.seed!r}")
+        if not (isinstance(self.seed, int) and not isinstance(self.seed, bool) and 0 <= self.seed < 2 ** 63):
+            bad(f"seed must be an integer in [0, 2^63), got {self.seed!r}")
         _check_range("wind", self.omega_range)
         if not (_number(self.height) and self.height > 0):
             bad(f"height must be a number > 0 (m), got {self.height!r}")

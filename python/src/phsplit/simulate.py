@@ -112,6 +112,9 @@ def simulate(
         if y0.ndim != 1:
             raise _core.InvalidInputError(f"a flat initial state is a 1-D array of {_core.STATE_DIM} numbers, "
                                           f"got shape {y0.shape}")
+    if save_at is not None and settings.save_every != 1:
+        raise _core.InvalidInputError(f"save_at gives the saved times itself, so save_every = {settings.save_every!r} "
+                                      f"would not be used: give one of them")
     if running_max and (save_at is not None or events):
         raise _core.InvalidInputError("running_max cannot be combined with save_at or events")
     if events is not None and not isinstance(events, (list, tuple)):
