@@ -395,6 +395,18 @@ def full_initial(params: dict, y0) -> np.ndarray:
     return y
 
 
+def control_segments(control_start, t_end: float) -> list[tuple[float, float, bool]]:
+    """The pieces of [0, t_end] with the controller off and on, (start, end, on): the reference
+    is integrated piecewise, so that the switch is a node and not a kink inside a step."""
+    segments = []
+    cs = control_start if control_start is not None else np.inf
+    if cs > 0:
+        segments.append((0.0, min(cs, t_end), False))
+    if cs < t_end:
+        segments.append((max(cs, 0.0), t_end, True))
+    return segments
+
+
 def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | None, t_eval=None,
           rtol: float = 1e-13) -> tuple[np.ndarray, np.ndarray]:
     """Reference solution on [0, t_end]: DOP853 with rtol 1e-13, split at the controller switch.
@@ -402,12 +414,7 @@ def solve(params: dict, y0: np.ndarray, t_end: float, control_start: float | Non
     port-Hamiltonian subsystem's states (n) where the vessel has them. ``y0`` is the 27 numbers,
     or the 27 then the subsystem's states (phsplit's layout of a state that continues a run); the
     filter starts at rest on the first set point, the subsystem at its ``initial``."""
-    segments = []
-    cs = control_start if control_start is not None else np.inf
-    if cs > 0:
-        segments.append((0.0, min(cs, t_end), False))
-    if cs < t_end:
-        segments.append((max(cs, 0.0), t_end, True))
+    segments = control_segments(control_start, t_end)
     t_eval = np.asarray(t_eval) if t_eval is not None else np.array([t_end])
     ts, ys = [], []
     y = full_initial(params, y0)

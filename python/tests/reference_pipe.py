@@ -65,7 +65,7 @@ Checks made when this was written (the paper's vessel, the line below with r_h =
 from __future__ import annotations
 
 import numpy as np
-from reference import Field, full_initial
+from reference import Field, control_segments, full_initial
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.sparse import csc_matrix, lil_matrix
@@ -567,12 +567,7 @@ def solve_coupled(vessel_params: dict, pipe: dict | None, y0_vessel, pipe_nodes0
     nv = len(yv)
     if atol is None:
         atol = default_atol(vessel_params, pipe, y, rtol)
-    segments = []
-    cs = control_start if control_start is not None else np.inf
-    if cs > 0:
-        segments.append((0.0, min(cs, t_end), False))
-    if cs < t_end:
-        segments.append((max(cs, 0.0), t_end, True))
+    segments = control_segments(control_start, t_end)
     t_eval = np.asarray(t_eval, float) if t_eval is not None else np.array([t_end])
     ts, ys, stats = [], [], []
     for a, b, on in segments:

@@ -142,33 +142,9 @@ def positioned_vessel(case: Case) -> phsplit.Vessel:
     d["control"]["position_reference"] = [0.0, 0.0, 0.0]
     d["control"]["euler_reference"] = [0.0, 0.0, 0.0]
     v = phsplit.Vessel.from_dict(d, f"{case.preset}, holding the origin")
-    # what the linear model of linear_model() and controller_gains() covers, and nothing else
+    # what the linear model of seakeeping.linear_model() and controller_gains() covers, and nothing else
     assert set(v.components) <= {"damping", "restoring", "pid"}, v.components
     return v
-
-
-def linear_model(vessel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(M, D, C)`` about the body origin: the rigid body's mass matrix (the vessel's mass matrix
-    less its added mass: the centre of gravity may be off the origin), its linear damping, and
-    its restoring linearised about upright with the heave spring at the centre of flotation
-    ``(x_F, y_F)``: ``C33 = ρgA_wp``, ``C34 = y_F C33``, ``C35 = −x_F C33``, ``C45 = −x_F y_F C33``,
-    ``C44 = mg GM_T + y_F² C33``, ``C55 = mg GM_L + x_F² C33`` (Fossen 2021, §4.2;
-    docs/explanation/components/heave-spring.md)."""
-    p = vessel.to_dict()["vessel"]
-    M = vessel.mass_matrix - np.asarray(p.get("added_mass", np.zeros((6, 6))), float)
-    D = (np.array(p["damping_matrix"], float) if "damping_matrix" in p
-         else np.diag([*p["damping_translational"], *p["damping_rotational"]]))
-    m, g = p["mass"], p["gravity"]
-    c = p["water_density"] * g * p["waterplane_area"]
-    xf, yf = p.get("flotation_center_x", 0.0), p.get("flotation_center_y", 0.0)
-    C = np.zeros((6, 6))
-    C[2, 2] = c
-    C[2, 3] = C[3, 2] = yf * c
-    C[2, 4] = C[4, 2] = -xf * c
-    C[3, 4] = C[4, 3] = -xf * yf * c
-    C[3, 3] = m * g * p["gm_transverse"] + yf ** 2 * c
-    C[4, 4] = m * g * p["gm_longitudinal"] + xf ** 2 * c
-    return M, D, C
 
 
 def controller_gains(vessel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -179,7 +155,7 @@ def controller_gains(vessel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 class FrequencyDomain:
-    """The RAO of :func:`linear_model` with the controller and the dataset's ``A``, ``B``, ``F``
+    """The RAO of :func:`phsplit.seakeeping.linear_model` with the controller and the dataset's ``A``, ``B``, ``F``
     (or, with ``memory``, the fitted memory ``−ω² A∞ + iω K_fit(iω)`` in place of the dataset's
     ``−ω² A(ω) + iω B(ω)``: the model the run integrates)."""
 
@@ -192,7 +168,7 @@ class FrequencyDomain:
         self.A = a_inf + np.asarray(K).imag / self.w[:, None, None]
         self.B = np.asarray(K).real
         self.memory = memory
-        self.M, self.D, self.C = linear_model(vessel)
+        self.M, self.D, self.C = seakeeping.linear_model(vessel)
         gains = controller_gains(vessel)
         self.Kp, self.Kd, self.Ki = gains if control else (np.zeros((6, 6)),) * 3
 
@@ -328,8 +304,9 @@ def case_runs(request):
 
 def test_the_controller_holds_surge_sway_yaw_only_and_the_theory_is_seakeepings_rao():
     """The paper vessel's heave, roll and pitch gains are zero (the controller as shipped); its
-    ``(M, D, C)`` here is :func:`phsplit.seakeeping.linear_model`'s (centre of gravity and of
-    flotation at the origin); with the gains zero the RAO here is
+    ``(M, D, C)`` is :func:`phsplit.seakeeping.linear_model`'s, whose rigid body is the core's
+    mass matrix less the added mass (the paper's vessel and the OSV, centre of gravity off the
+    origin); with the gains zero the RAO here is
     :func:`phsplit.seakeeping.frequency_rao` at the dataset's nodes and between its frequencies."""
     case = PAPER_BOX
     vessel = positioned_vessel(case)
@@ -337,8 +314,9 @@ def test_the_controller_holds_surge_sway_yaw_only_and_the_theory_is_seakeepings_
         c = phsplit.Vessel.preset(preset).to_dict()["control"]
         for k in ("kp", "kd", "ki"):
             assert c[f"{k}_translational"][2] == 0.0 and c[f"{k}_rotational"][:2] == [0.0, 0.0], (preset, k)
-    for a, b in zip(linear_model(vessel), seakeeping.linear_model(vessel)):
-        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-6)
+    for v in (vessel, positioned_vessel(OSV)):   # the frequency domain's rigid body is the core's
+        added = np.asarray(v.to_dict()["vessel"].get("added_mass", np.zeros((6, 6))), float)
+        np.testing.assert_allclose(seakeeping.linear_model(v)[0], v.mass_matrix - added, rtol=1e-12, atol=1e-6)
     fd = FrequencyDomain(vessel, case.dataset, control=False)
     data = radiation.retardation_data(case.dataset, vessel=vessel)
     omega = np.array([0.44, 0.5, 0.566, 0.9, 1.52])

@@ -392,8 +392,8 @@ def _check(d: _Data, symmetric: bool, vessel: dict | None) -> tuple[list[str], l
         # added mass times the fluid's acceleration). Measured on the shipped datasets, |X| over
         # that is 0.96-1.02 (roll, pitch), the Froude-Krylov part alone 1.39 for the OSV's roll.
         AW = shift_matrix(r).T @ d.A[i0] @ shift_matrix(r)
-        xb = (d.cb - np.array([0.0, 0.0, d.rc[2]]) - d.rc * np.array([1.0, 1.0, 0.0])) if d.cb is not None \
-            else np.zeros(3)
+        # the centre of buoyancy's horizontal offsets (the same from the rotation centre and from W)
+        xb = d.cb - d.rc if d.cb is not None else np.zeros(3)
         w2 = w[i0] ** 2
         in_phase = {3: C[3, 2] - w2 * (rho * d.vol * xb[1] + AW[3, 2]),
                     4: C[4, 2] + w2 * (rho * d.vol * xb[0] - AW[4, 2])}

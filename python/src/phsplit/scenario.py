@@ -308,24 +308,20 @@ def _environment(env: Any, path: str, base_dir: str, vessel: Mapping[str, Any] |
                 table = hydro.from_capytaine(p, symmetric=sym, checks=checks, vessel=vessel)["waves"]
             except _core.InvalidInputError as e:
                 raise _core.InvalidInputError(f"{path}: environment.waves.hydro: {e}") from None
-            f = table["rao_frequencies"]
-            if state.omega_range is not None and not (float(f[0]) - 1e-9 <= state.range()[0]
-                                                      and state.range()[1] <= float(f[-1]) + 1e-9):
+            f0, f1 = float(table["rao_frequencies"][0]), float(table["rao_frequencies"][-1])
+            lo, hi = state.range()
+            if state.omega_range is not None and not (f0 - 1e-9 <= lo and hi <= f1 + 1e-9):
                 raise _core.InvalidInputError(
-                    f"{path}: environment.waves.omega_range = [{state.range()[0]:g}, {state.range()[1]:g}] rad/s "
-                    f"reaches outside the dataset's {float(f[0]):g}-{float(f[-1]):g} rad/s (its transfer functions are "
-                    f"not extrapolated): give a range inside it, or leave omega_range out for the default within it")
-            if state.omega_range is None:
-                # the default range, [0.5, 3] omega_p, within the dataset's frequencies
-                lo, hi = state.range()
-                f = table["rao_frequencies"]
-                lo, hi = max(lo, float(f[0])), min(hi, float(f[-1]))
-                if not lo < hi:
+                    f"{path}: environment.waves.omega_range = [{lo:g}, {hi:g}] rad/s reaches outside the dataset's "
+                    f"{f0:g}-{f1:g} rad/s (its transfer functions are not extrapolated): give a range inside it, "
+                    f"or leave omega_range out for the default within it")
+            if state.omega_range is None:   # the default range, [0.5, 3] omega_p, within the dataset's
+                if not max(lo, f0) < min(hi, f1):
                     raise _core.InvalidInputError(
-                        f"{path}: environment.waves: the spectrum's range [0.5, 3] omega_p = "
-                        f"[{state.range()[0]:.3g}, {state.range()[1]:.3g}] rad/s lies outside the dataset's "
-                        f"{float(f[0]):g}-{float(f[-1]):g} rad/s: give omega_range, or a dataset that covers tp = {state.tp:g} s")
-                state = dataclasses.replace(state, omega_range=(lo, hi))
+                        f"{path}: environment.waves: the spectrum's range [0.5, 3] omega_p = [{lo:.3g}, {hi:.3g}] "
+                        f"rad/s lies outside the dataset's {f0:g}-{f1:g} rad/s: give omega_range, or a dataset "
+                        f"that covers tp = {state.tp:g} s")
+                state = dataclasses.replace(state, omega_range=(max(lo, f0), min(hi, f1)))
             comps = state.realise()
             outside = _outside_directions(table.get("rao_directions", []), comps.get("directions", []))
             if outside is not None:
