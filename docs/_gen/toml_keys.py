@@ -53,6 +53,20 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "ki_rotational": ("N m/(rad s)", REQ, "integral gains"),
         "euler_reference": ("rad", REQ, "set attitude (roll, pitch, yaw), each within ±2π"),
         "position_reference": ("m", REQ, "set position, spatial frame"),
+        "feedback": ("-", '"true_state"', '`"true_state"` (the paper\'s) or `"observer"`: the controller acts on the estimates of `[observer]` (§5.20)'),
+    },
+    "observer": {
+        "wave_frequency": ("rad/s", REQ, "`ω₀` of the wave model, > 0: the sea's peak frequency (§5.20)"),
+        "damping": ("kg/s, kg/s, kg m²/s", REQ, "the observer's model damping in surge, sway, yaw, ≥ 0"),
+        "wave_damping": ("-", "0.1", "`λ` of the wave model, > 0"),
+        "notch_damping": ("-", "1", "`ζₙ` of the notch, > `λ`"),
+        "cutoff_frequency": ("rad/s", "1.2255 ω₀", "`ω_c` of the wave filter, > `ω₀`"),
+        "bias_time_constant": ("s", "1000", "`T` of the bias model, > 0"),
+        "bias_bandwidth": ("rad/s", "ω₀/5", "`ω_b` at which `K₃`, `K₄` place the low-frequency error dynamics critically damped"),
+        "velocity_gain": ("N/m, N/m, N m/rad", "placed at `ω_b`", "`K₄`, > 0; with `bias_gain`, `1/T < K₃/K₄ < ω₀`"),
+        "bias_gain": ("N/(m s), N/(m s), N m/(rad s)", "placed at `ω_b`", "`K₃`, > 0"),
+        "initial_estimate": ("m, m, rad", "the measured", "initial `(x̂, ŷ, ψ̂)`"),
+        "initial_bias": ("N, N, N m", "[0, 0, 0]", "initial bias estimate, spatial frame"),
     },
     "external": {
         "force": ("N", "[0, 0, 0]", "constant force (§5.4)"),
@@ -245,6 +259,7 @@ SOURCE = {
     "current": "`forces/current.rs`",
     "damping_quadratic": "`forces/damping_quadratic.rs`",
     "roll_damping": "`forces/roll_damping.rs`",
+    "observer": "`forces/observer.rs`",
     "crossflow_drag": "`forces/crossflow.rs`",
     "pipe": "`forces/pipe.rs`",
     "pipe.lumped_mass": "`forces/pipe/lumped.rs`",
@@ -287,6 +302,7 @@ def accepted() -> dict[str, set[str]]:
                 {**paper, "external": {"force": [1.0, 0.0, 0.0]},
                  "damping_quadratic": {"coefficients": [0.0] * 6},
                  "roll_damping": {"critical_fraction": 0.05}},
+                _examples()["observer"],
                 _examples()["spring"], _examples()["port_hamiltonian"]]
     out: dict[str, set[str]] = {}
     for table in _core.vessel_tables():
@@ -324,6 +340,8 @@ def _examples() -> dict[str, dict]:
             "wind": weather, "crossflow_drag": phsplit.Vessel.preset("osv").to_dict(),
             "damping_quadratic": {**paper, "damping_quadratic": {"coefficients": [1.0] * 6}},
             "roll_damping": {**paper, "roll_damping": {"critical_fraction": 0.05, "quadratic": 1.0e9}},
+            "observer": {**paper, "control": {**paper["control"], "feedback": "observer"},
+                         "observer": {"wave_frequency": 0.7, "damping": [3.5e4, 1.2e5, 3.2e8]}},
             "spring": {**paper, "spring": {"fairlead": [30.0, 0.0, 0.0], "anchor": [700.0, 0.0, -5.0], "stiffness": 1.0e4}},
             "port_hamiltonian": {**paper, "port_hamiltonian": {
                 "name": "port_hamiltonian", "states": ["q", "p"], "units": ["1", "1"], "J": [[0.0, 1.0], [-1.0, 0.0]],
@@ -458,7 +476,7 @@ def render() -> str:
         ("Scenario files", ["simulation", "environment.waves", "environment.wind"]),
         ("Vessel files (and any scenario, table by table)",
          ["vessel", "initial", "control", "external", "current", "damping_quadratic", "roll_damping", "crossflow_drag",
-          "pipe", "pipe.lumped_mass", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
+          "observer", "pipe", "pipe.lumped_mass", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
         ("Sweep files", ["sweep"]),
     ]
     for title, tables in groups:

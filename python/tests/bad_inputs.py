@@ -1252,3 +1252,40 @@ CATALOGUE += [
     Bad("sea seed beyond 2^63", lambda: phsplit.sea.SeaState(hs=2.0, tp=9.0, seed=2 ** 70), E,
         ("seed must be an integer in [0, 2^63)",)),
 ]
+
+
+_OBS = "[observer]\nwave_frequency = 0.7\ndamping = [3.5e4, 1.2e5, 3.2e8]\n"
+
+
+def _observer(extra: str = "", feedback: str = 'feedback = "observer"\n') -> Callable[[], object]:
+    return vessel_with("[control]\n", _OBS + extra + "\n[control]\n" + feedback)
+
+
+CATALOGUE += [
+    # the passive observer and the controller on its estimates
+    Bad("observer table without the controller's feedback on it", _observer(feedback=""), E,
+        ("[observer]", "control.feedback")),
+    Bad("controller on an observer that is not there",
+        vessel_with("[control]\n", '[control]\nfeedback = "observer"\n'), E,
+        ("control.feedback", "[observer]", "wave_frequency")),
+    Bad("controller feedback of an unknown kind",
+        vessel_with("[control]\n", '[control]\nfeedback = "estimates"\n'), E,
+        ("control.feedback", "'true_state'", "'observer'")),
+    Bad("observer notch damped less than its wave model", _observer("notch_damping = 0.05\n"), E,
+        ("observer.notch_damping", "wave_damping")),
+    Bad("observer cut-off below its wave frequency", _observer("cutoff_frequency = 0.5\n"), E,
+        ("observer.cutoff_frequency", "wave_frequency")),
+    Bad("observer gains outside Fossen's rule",
+        _observer("velocity_gain = [1e5, 1e5, 1e8]\nbias_gain = [1e5, 1e5, 1e8]\n"), E,
+        ("bias_gain[0] / velocity_gain[0]", "1/bias_time_constant", "wave_frequency")),
+    Bad("observer bias bandwidth below what its model damping allows", _observer("bias_bandwidth = 0.01\n"), E,
+        ("observer", "bias_bandwidth", "velocity_gain")),
+    Bad("observer with a wave frequency of zero",
+        vessel_with("[control]\n", "[observer]\nwave_frequency = 0.0\ndamping = [1.0, 1.0, 1.0]\n\n[control]\nfeedback = \"observer\"\n"), E,
+        ("observer.wave_frequency", "> 0")),
+    Bad("observer without its model damping",
+        vessel_with("[control]\n", "[observer]\nwave_frequency = 0.7\n\n[control]\nfeedback = \"observer\"\n"), E,
+        ("observer.damping",)),
+    Bad("observer with a key it does not take", _observer("wave_period = 9.0\n"), E,
+        ("wave_period", "[observer]")),
+]

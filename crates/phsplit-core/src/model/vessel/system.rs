@@ -372,7 +372,7 @@ impl<'a> VesselSystem<'a> {
                 }
                 let mut own = Vec::new();
                 if self.own_dim > 0 {
-                    let (mut rates, tau) = self.own_field(&zs, &s.own);
+                    let (mut rates, tau) = self.own_field(&view, &zs, &s.own);
                     ft[0] += tau[0];
                     fr[0] += tau[1];
                     for (_, tau) in self.own_flow_field(&view, s, &mut rates) {

@@ -52,12 +52,14 @@ pub mod current;
 pub mod damping;
 pub mod damping_quadratic;
 pub mod external;
+pub mod observer;
 mod own;
 pub mod pid;
 pub mod pipe;
 pub mod port_hamiltonian;
 pub mod restoring;
 pub mod roll_damping;
+mod setpoint;
 pub mod spring;
 pub mod thrusters;
 pub mod waves;
@@ -79,7 +81,11 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("crossflow_drag", &["crossflow_drag"], crossflow::build),
     ("roll_damping", &["roll_damping"], roll_damping::build),
     ("restoring", &["vessel"], restoring::build),
-    ("pid", &["control", "setpoint", "thrusters"], pid::build),
+    (
+        "pid",
+        &["control", "setpoint", "thrusters", "observer"],
+        pid::build,
+    ),
     ("external", &["external"], external::build),
     ("current", &["current"], current::build),
     ("pipe", &["pipe"], pipe::build),
@@ -503,6 +509,11 @@ pub trait Force: Debug + Send + Sync {
     /// How its own states evolve in flow S2 and what they do to the hull ([`OwnLinear`]).
     /// A component with own states gives them (flow S1 leaves them unchanged).
     fn own_linear(&self) -> Option<&OwnLinear> {
+        None
+    }
+    /// Its own states' rows at the frozen view `fr` when they depend on it (an observer's, on
+    /// the measured heading); `None`: [`Force::own_linear`]'s, the same at every attitude.
+    fn own_linear_at(&self, _fr: &Frozen) -> Option<OwnLinear> {
         None
     }
     /// Energy stored in its own states `x`, a part of H (J).

@@ -30,11 +30,12 @@
 //! times. It is booked with the P and I terms as `control` (the `Kd x_d'` term too: it is a
 //! port term, not dissipation).
 
+use super::observer::{self, Observer};
 use super::thrusters::{self, Thrusters};
-use super::{Force, Forcing, Frozen, Output, Rows, S2Builder, Sys};
+use super::{Force, Forcing, Frozen, Output, OwnLinear, OwnState, Rows, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
-use crate::model::reference::{Interpolation, Reference, CHANNELS};
+use crate::model::reference::Reference;
 use crate::model::vessel::params::{physical, Params, Range};
 use crate::model::vessel::state::{Actuators, VesselState};
 use crate::solve::Account;
@@ -58,6 +59,9 @@ pub struct Pid {
     /// The thrusters that deliver the controller's force, if any (else it acts unlimited, as
     /// in the paper).
     pub thrusters: Option<Thrusters>,
+    /// With `feedback = "observer"`: the observer whose estimates the controller acts on
+    /// (`observer.rs`); else it acts on the vessel's state.
+    pub observer: Option<Observer>,
 }
 
 /// Table `[control]`: the six gain vectors (≥ 0, SI) and the set point (finite); all required.
@@ -79,11 +83,41 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         Range::Physical(&physical::ANGLE_RAD),
     )?;
     let position_reference = p.vec3("control", "position_reference", None, "m", Range::Finite)?;
-    let setpoint = setpoint(p, &euler_reference)?;
+    let setpoint = super::setpoint::read(p, &euler_reference)?;
     let thrusters = thrusters::read(p)?;
+    p.declare("observer");
+    let observer = match p.choice("control", "feedback", &["true_state", "observer"])? {
+        "observer" => {
+            for (what, there) in [
+                ("[setpoint] (a moving set point)", setpoint.is_some()),
+                ("[thrusters]", thrusters.is_some()),
+            ] {
+                if there {
+                    return Err(Error::InvalidInput(format!(
+                        "control.feedback = \"observer\" does not yet take {what}: the controller on the observer's estimates acts unlimited on a fixed set point (docs/model.md §5.20); remove {what} or use feedback = \"true_state\""
+                    )));
+                }
+            }
+            let gains = observer::Gains {
+                kp: [kp_translational, kp_rotational],
+                kd: [kd_translational, kd_rotational],
+                ki: [ki_translational, ki_rotational],
+                position_reference: position_reference.into(),
+                euler_reference: euler_reference.into(),
+            };
+            Some(observer::read(p, _body, &gains)?)
+        }
+        _ if p.has("observer") => {
+            return Err(Error::InvalidInput(
+                "an [observer] table needs control.feedback = \"observer\" (the observer's estimates act through the controller); set it, or remove [observer] for the controller on the vessel's state".into(),
+            ))
+        }
+        _ => None,
+    };
     Ok(Some(Arc::new(Pid {
         setpoint,
         thrusters,
+        observer,
         kp_translational,
         kd_translational,
         ki_translational,
@@ -95,122 +129,13 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     })))
 }
 
-/// The `[setpoint]` table, if present (see the module documentation).
-fn setpoint(p: &mut Params, euler_reference: &[f64; 3]) -> crate::Result<Option<Reference>> {
-    const T: &str = "setpoint";
-    p.declare(T);
-    if !p.has(T) {
-        return Ok(None);
-    }
-    let omega = p.f64(T, "natural_frequency", "rad/s", Range::Positive)?;
-    let zeta = p
-        .opt_f64(T, "relative_damping", "dimensionless", Range::Positive)?
-        .unwrap_or(1.0);
-    let interpolation = match p.choice(T, "interpolation", &["linear", "step"])? {
-        "step" => Interpolation::Step,
-        _ => Interpolation::Linear,
-    };
-    let positions = p
-        .rows(T, "positions", 3, "m, spatial", Range::Finite)?
-        .ok_or_else(|| {
-            Error::Parse("missing field `positions` in [setpoint] (rows of 3 numbers, m, spatial: the set points)".into())
-        })?;
-    if positions.is_empty() {
-        return Err(Error::InvalidInput(
-            "setpoint.positions must have at least one row (m, spatial)".into(),
-        ));
-    }
-    let headings = p.rows(
-        T,
-        "headings",
-        1,
-        "rad",
-        Range::Physical(&physical::ANGLE_RAD),
-    )?;
-    if let Some(hd) = &headings {
-        if hd.len() != positions.len() {
-            return Err(Error::InvalidInput(format!(
-                "setpoint.headings must have one value per row of setpoint.positions ({} rows), got {}",
-                positions.len(),
-                hd.len()
-            )));
-        }
-    }
-    let times = p.rows(T, "times", 1, "s", Range::Physical(&physical::TIME))?;
-    let speed = p.opt_f64(T, "speed", "m/s", Range::Positive)?;
-    let start = p.opt_f64(T, "start_time", "s", Range::Physical(&physical::TIME))?;
-    let times: Vec<f64> = match (times, speed) {
-        (Some(t), None) => {
-            if start.is_some() {
-                return Err(Error::InvalidInput(
-                    "setpoint.start_time goes with setpoint.speed (waypoints); with setpoint.times each row has its own time".into(),
-                ));
-            }
-            if t.len() != positions.len() {
-                return Err(Error::InvalidInput(format!(
-                    "setpoint.times must have one value per row of setpoint.positions ({} rows), got {}",
-                    positions.len(),
-                    t.len()
-                )));
-            }
-            t.into_iter().map(|r| r[0]).collect()
-        }
-        (None, Some(v)) => {
-            let mut t = vec![start.unwrap_or(0.0)];
-            for k in 1..positions.len() {
-                let d: f64 = (0..3)
-                    .map(|i| (positions[k][i] - positions[k - 1][i]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                if d == 0.0 {
-                    return Err(Error::InvalidInput(format!(
-                        "setpoint.positions[{k}] repeats the waypoint before it: waypoints passed at a speed must differ"
-                    )));
-                }
-                t.push(t[k - 1] + d / v);
-            }
-            t
-        }
-        (Some(_), Some(_)) => {
-            return Err(Error::InvalidInput(
-                "[setpoint] takes either times (s, one per row) or speed (m/s, waypoints), not both".into(),
-            ))
-        }
-        (None, None) => {
-            return Err(Error::InvalidInput(
-                "[setpoint] needs times (s, one per row of positions) or speed (m/s, the rows are waypoints)".into(),
-            ))
-        }
-    };
-    // Headings are unwrapped: each row turns the short way from the one before (3.1 then
-    // −3.1 rad is a turn of 0.08 rad, not of 6.2).
-    let mut yaw_prev: Option<f64> = None;
-    let values: Vec<[f64; CHANNELS]> = positions
-        .iter()
-        .enumerate()
-        .map(|(k, r)| {
-            let mut yaw = headings.as_ref().map_or(euler_reference[2], |h| h[k][0]);
-            if let Some(prev) = yaw_prev {
-                yaw = prev + wrap_pi(yaw - prev);
-            }
-            yaw_prev = Some(yaw);
-            [
-                r[0],
-                r[1],
-                r[2],
-                euler_reference[0],
-                euler_reference[1],
-                yaw,
-            ]
-        })
-        .collect();
-    Reference::new(omega, zeta, times, values, interpolation).map(Some)
-}
-
 const ACCOUNTS: [Account; 2] = [
     Account::supplied("control").control(),
     Account::dissipated("control_damping").control(),
 ];
+
+/// On the observer's estimates, the controller's whole force is one port.
+const OBSERVER_ACCOUNTS: [Account; 1] = [Account::supplied("control").control()];
 
 /// With thrusters, the controller's whole force is what they deliver: one port.
 const THRUSTER_ACCOUNTS: [Account; 1] = [Account::supplied("thrusters").control()];
@@ -526,7 +451,9 @@ impl Force for Pid {
         }
     }
     fn accounts(&self) -> &'static [Account] {
-        if self.thrusters.is_some() {
+        if self.observer.is_some() {
+            &OBSERVER_ACCOUNTS
+        } else if self.thrusters.is_some() {
             &THRUSTER_ACCOUNTS
         } else {
             &ACCOUNTS
@@ -560,8 +487,28 @@ impl Force for Pid {
             act.t = t;
         }
     }
+    fn own_states(&self) -> &[OwnState] {
+        self.observer.as_ref().map_or(&[], |o| o.states())
+    }
+    fn own_linear(&self) -> Option<&OwnLinear> {
+        self.observer.as_ref().map(|o| o.template())
+    }
+    fn own_linear_at(&self, fr: &Frozen) -> Option<OwnLinear> {
+        self.observer.as_ref().map(|o| o.rows_at(fr))
+    }
+    fn init_own(&self, s: &VesselState, x: &mut [f64]) -> crate::error::Result<()> {
+        if let Some(o) = &self.observer {
+            o.init(&s.x, crate::lie::so3::euler_and_w(&s.q).0.z, x);
+        }
+        Ok(())
+    }
+    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], out: &mut Vec<Output>) {
+        if let Some(o) = &self.observer {
+            o.outputs(fr, z, x, out);
+        }
+    }
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {
-        if !fr.control_on {
+        if !fr.control_on || self.observer.is_some() {
             return;
         }
         let r = self.rows(fr);

@@ -359,14 +359,14 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     let mut t = DMatrix::zeros(n + k, n + 6);
     t.view_mut((0, 0), (n, n)).copy_from(&q);
     t.view_mut((n, n), (k, 6)).copy_from(&b);
-    let lin = OwnLinear {
-        axx: (&j - &r) * &q,
-        axnu: (&g - &pm) * &b,
-        fx: -b.transpose() * &y_x,
-        fnu: -b.transpose() * &y_u * &b,
-        account: 0,
-        diss: t.transpose() * &d * &t,
-    };
+    let lin = OwnLinear::exchange(
+        (&j - &r) * &q,
+        (&g - &pm) * &b,
+        -b.transpose() * &y_x,
+        -b.transpose() * &y_u * &b,
+        0,
+        t.transpose() * &d * &t,
+    );
     let states = states
         .iter()
         .zip(units)

@@ -2,7 +2,7 @@
 //! the two block systems and what couples them, or of the dense system with the components' own
 //! states.
 
-use super::super::forces::S2Builder;
+use super::super::forces::{Frozen, S2Builder};
 use super::s2;
 use super::VesselSystem;
 use nalgebra::{DMatrix, Matrix3};
@@ -90,7 +90,7 @@ impl VesselSystem<'_> {
     pub fn natural_periods(&self, q: &Matrix3<f64>, on: bool) -> Vec<f64> {
         let b = self.s2_at(q, on, false);
         if self.own_linear_dim > 0 {
-            return self.natural_periods_own(&b);
+            return self.natural_periods_own(&self.frozen_at(q, on), &b);
         }
         // The 18×18 system (the two block systems and what couples them), without the
         // constant column.
@@ -100,8 +100,8 @@ impl VesselSystem<'_> {
 
     /// [`Self::natural_periods`] of the dense system with the components' own states, balanced
     /// (a similarity: the eigenvalues are the system's).
-    fn natural_periods_own(&self, b: &S2Builder) -> Vec<f64> {
-        let (a, _) = self.dense_balanced(b);
+    fn natural_periods_own(&self, fr: &Frozen, b: &S2Builder) -> Vec<f64> {
+        let (a, _) = self.dense_balanced(fr, b);
         let n = a.nrows() - 1;
         periods(a.view((0, 0), (n, n)).into_owned())
     }

@@ -22,6 +22,8 @@ use super::{GaveUp, LinearFlow, VesselSystem};
 use crate::flows::collocation::{self as gauss, Z3};
 use crate::solve::Work;
 use nalgebra::{DMatrix, DVector, Vector3};
+use std::borrow::Cow;
+type Span = std::ops::Range<usize>;
 
 /// The momentum entries `u_t`, `u_r` of `w` (as of `z̄`).
 const MOMENTA: [usize; 6] = [0, 1, 2, 9, 10, 11];
@@ -63,21 +65,24 @@ pub(super) fn flowing_of(vessel: &super::Vessel) -> Vec<(usize, std::ops::Range<
     parts
 }
 
-/// A linear own-state component in flow S2: its account, its rows, its columns in `w` and its
-/// range in [`VesselState::own`].
+/// A linear own-state component in flow S2: its account, rows, columns in `w`, range in `own`.
 pub(super) struct LinearPart<'a> {
     pub account: usize,
-    pub rows: &'a OwnLinear,
+    pub rows: Cow<'a, OwnLinear>,
     pub cols: std::ops::Range<usize>,
     pub own: std::ops::Range<usize>,
 }
 
 impl<'a> VesselSystem<'a> {
     /// The components whose own states are linear in flow S2 (the layout found once, in
-    /// [`VesselSystem::new`]).
-    fn own_parts<'s>(&'s self) -> impl Iterator<Item = LinearPart<'a>> + 's {
-        self.own_parts.iter().filter_map(|(i, r, col)| {
-            let l = self.vessel.forces[*i].own_linear()?;
+    /// [`VesselSystem::new`]), with their rows at the frozen view `fr`.
+    fn own_parts<'s>(&'s self, fr: &'s Frozen) -> impl Iterator<Item = LinearPart<'a>> + 's {
+        self.own_parts.iter().filter_map(move |(i, r, col)| {
+            let f = &self.vessel.forces[*i];
+            let l = match f.own_linear_at(fr) {
+                Some(l) => Cow::Owned(l),
+                None => Cow::Borrowed(f.own_linear()?),
+            };
             Some(LinearPart {
                 account: self.bases[*i] + l.account,
                 rows: l,
@@ -151,17 +156,23 @@ impl VesselSystem<'_> {
         let z0 = self.blocks_of(s);
         let w0 = self.pack(&z0, &s.own);
         let (w1, work) = self.with_s2(s, on, ledger, false, |fr, b| {
-            let a = self.dense(b);
+            let a = self.dense(fr, b);
             if self.forced || self.linear == LinearFlow::Gauss {
                 self.dense_collocation(fr, b, &a, &w0, h, t, stages)
             } else {
-                self.dense_exact(b, &a, &w0, h)
+                self.dense_exact(fr, b, &a, &w0, h)
             }
         });
         let (z1, x1) = self.unpack(&w1, &s.own);
         self.set_blocks(s, &z1);
         s.own = x1;
         work
+    }
+
+    /// Each linear own-state component's columns in `w` and its range in [`VesselState::own`].
+    fn own_columns(&self) -> impl Iterator<Item = (Span, Span)> + '_ {
+        let span = |(_, r, col): &(usize, Span, usize)| (*col..*col + r.len(), r.clone());
+        self.own_parts.iter().map(span)
     }
 
     fn dim(&self) -> usize {
@@ -175,9 +186,8 @@ impl VesselSystem<'_> {
                 w.rows_mut(9 * k + 3 * i, 3).copy_from(&z[k][i]);
             }
         }
-        for p in self.own_parts() {
-            w.rows_mut(p.cols.start, p.cols.len())
-                .copy_from_slice(&x[p.own]);
+        for (cols, own) in self.own_columns() {
+            w.rows_mut(cols.start, cols.len()).copy_from_slice(&x[own]);
         }
         w[self.dim() - 1] = 1.0;
         w
@@ -190,8 +200,8 @@ impl VesselSystem<'_> {
         });
         let mut own = x.to_vec();
         if !own.is_empty() {
-            for p in self.own_parts() {
-                own[p.own].copy_from_slice(&w.as_slice()[p.cols]);
+            for (cols, own_range) in self.own_columns() {
+                own[own_range].copy_from_slice(&w.as_slice()[cols]);
             }
         }
         (z, own)
@@ -215,17 +225,23 @@ impl VesselSystem<'_> {
 
     /// The own states' rates and their generalised force on the hull (body frame) at the block
     /// states `z` and own states `x` (flow S2's field, eq. 41, for them).
-    pub(super) fn own_field(&self, z: &[Z3; 2], x: &[f64]) -> (Vec<f64>, [Vector3<f64>; 2]) {
+    pub(super) fn own_field(
+        &self,
+        fr: &Frozen,
+        z: &[Z3; 2],
+        x: &[f64],
+    ) -> (Vec<f64>, [Vector3<f64>; 2]) {
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
         let nu = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
+        let v = DVector::from_column_slice(z[0][1].as_slice());
         let mut rates = vec![0.0; x.len()];
         let mut tau = DVector::<f64>::zeros(6);
-        for p in self.own_parts() {
-            let l = p.rows;
+        for p in self.own_parts(fr) {
+            let l = &p.rows;
             let xi = DVector::from_column_slice(&x[p.own.clone()]);
-            let d = &l.axx * &xi + &l.axnu * &nu;
+            let d = &l.axx * &xi + &l.axnu * &nu + &l.axv * &v + &l.axc;
             rates[p.own].copy_from_slice(d.as_slice());
-            tau += &l.fx * &xi + &l.fnu * &nu;
+            tau += &l.fx * &xi + &l.fnu * &nu + &l.fc;
         }
         (
             rates,
@@ -237,14 +253,19 @@ impl VesselSystem<'_> {
     }
 
     /// Each own-state component's account with its force and moment on the hull (body frame).
-    pub(super) fn own_wrenches(&self, z: &[Z3; 2], x: &[f64]) -> Vec<(usize, [Vector3<f64>; 2])> {
+    pub(super) fn own_wrenches(
+        &self,
+        fr: &Frozen,
+        z: &[Z3; 2],
+        x: &[f64],
+    ) -> Vec<(usize, [Vector3<f64>; 2])> {
         let nu = self.vessel.body.velocity(&z[0][0], &z[1][0]);
         let nu = DVector::from_iterator(6, nu[0].iter().chain(nu[1].iter()).cloned());
-        self.own_parts()
+        self.own_parts(fr)
             .map(|p| {
-                let l = p.rows;
+                let l = &p.rows;
                 let xi = DVector::from_column_slice(&x[p.own]);
-                let tau = &l.fx * &xi + &l.fnu * &nu;
+                let tau = &l.fx * &xi + &l.fnu * &nu + &l.fc;
                 (
                     p.account,
                     [
@@ -257,7 +278,7 @@ impl VesselSystem<'_> {
     }
 
     /// The dense matrix `A` of flow S2 with the own states.
-    fn dense(&self, b: &S2Builder) -> DMatrix<f64> {
+    fn dense(&self, fr: &Frozen, b: &S2Builder) -> DMatrix<f64> {
         let n = self.dim();
         let c = n - 1;
         let full = augmented(b);
@@ -269,11 +290,21 @@ impl VesselSystem<'_> {
             a[(i, c)] = full[(i, 18)];
         }
         let e = self.velocity_map();
-        for p in self.own_parts() {
-            let (l, r) = (p.rows, p.cols);
+        for p in self.own_parts(fr) {
+            let (l, r) = (&p.rows, p.cols);
             let m = r.len();
             let mut rows = a.view_mut((r.start, r.start), (m, m));
             rows += &l.axx;
+            // The rates on the position v = x − x_o (w's entries 3..6) and the constant.
+            for i in 0..m {
+                for j in 0..3 {
+                    a[(r.start + i, 3 + j)] += l.axv[(i, j)];
+                }
+                a[(r.start + i, c)] += l.axc[i];
+            }
+            for (i, &mi) in MOMENTA.iter().enumerate() {
+                a[(mi, c)] += l.fc[i];
+            }
             let xnu = &l.axnu * &e;
             let mut rows = a.rows_mut(r.start, m);
             rows += &xnu;
@@ -291,7 +322,7 @@ impl VesselSystem<'_> {
     }
 
     /// Each account's power as a quadratic form `wᵀ W w` (one `W` per account, not symmetric).
-    fn power_forms(&self, b: &S2Builder) -> Vec<DMatrix<f64>> {
+    fn power_forms(&self, fr: &Frozen, b: &S2Builder) -> Vec<DMatrix<f64>> {
         let n = self.dim();
         let c = n - 1;
         let col = |j: usize| if j == 18 { c } else { j };
@@ -308,8 +339,8 @@ impl VesselSystem<'_> {
             }
         }
         let e = self.velocity_map();
-        for p in self.own_parts() {
-            let (acc, l, r) = (p.account, p.rows, p.cols);
+        for p in self.own_parts(fr) {
+            let (acc, l, r) = (p.account, &p.rows, p.cols);
             // [x; ν] = T w; the dissipation is booked as a positive number.
             let m = r.len();
             let mut t = DMatrix::zeros(m + 6, n);
@@ -318,6 +349,18 @@ impl VesselSystem<'_> {
             }
             t.rows_mut(m, 6).copy_from(&e);
             out[acc] += t.transpose() * &l.diss * &t;
+            if l.port {
+                // A port's power ν·τ, τ = F w (F: fx on the own states, fnu ν, fc on the
+                // constant).
+                let mut f = &l.fnu * &e;
+                for i in 0..6 {
+                    for j in 0..m {
+                        f[(i, r.start + j)] += l.fx[(i, j)];
+                    }
+                    f[(i, c)] += l.fc[i];
+                }
+                out[acc] += (e.transpose() * f) * self.sign(acc);
+            }
         }
         out
     }
@@ -367,8 +410,12 @@ impl VesselSystem<'_> {
     }
 
     /// The dense matrix of `b` balanced, `S⁻¹ A S`, with the balance `S`.
-    pub(super) fn dense_balanced(&self, b: &S2Builder) -> (DMatrix<f64>, DVector<f64>) {
-        let a = self.dense(b);
+    pub(super) fn dense_balanced(
+        &self,
+        fr: &Frozen,
+        b: &S2Builder,
+    ) -> (DMatrix<f64>, DVector<f64>) {
+        let a = self.dense(fr, b);
         let sc = self.dense_balance(b, &a);
         let n = a.nrows();
         (DMatrix::from_fn(n, n, |i, j| a[(i, j)] * sc[j] / sc[i]), sc)
@@ -377,6 +424,7 @@ impl VesselSystem<'_> {
     /// The exact flow and, with the ledger, each account's energy from the Gramian.
     fn dense_exact(
         &self,
+        fr: &Frozen,
         b: &S2Builder,
         a: &DMatrix<f64>,
         w0: &DVector<f64>,
@@ -418,7 +466,7 @@ impl VesselSystem<'_> {
             e = &e * &e;
         }
         let w1 = (&e * &wb).component_mul(&sc);
-        let forms = self.power_forms(b);
+        let forms = self.power_forms(fr, b);
         let work = Work::from_fn(self.accounts.len(), |acc| {
             let w = &forms[acc];
             let mut e = 0.0;
@@ -531,7 +579,7 @@ impl VesselSystem<'_> {
         let w1 = unscale(&w1);
         let mut work = Work::default();
         if b.booked.is_some() {
-            let forms = self.power_forms(b);
+            let forms = self.power_forms(fr, b);
             for i in 0..s {
                 let y = unscale(&ys[i]);
                 let p = Work::from_fn(self.accounts.len(), |acc| y.dot(&(&forms[acc] * &y)));

@@ -62,7 +62,7 @@ impl VesselSystem<'_> {
         b.add_cross_booked(&z, &mut f);
         // A subsystem's force on the hull (its account books what it dissipates).
         let mut rates = vec![0.0; s.own.len()];
-        let own = self.own_wrenches(&z, &s.own);
+        let own = self.own_wrenches(&fr, &z, &s.own);
         for (acc, w) in own
             .into_iter()
             .chain(self.own_flow_field(&fr, s, &mut rates))
@@ -108,6 +108,15 @@ impl VesselSystem<'_> {
                     match sys {
                         Sys::Trans => force += f,
                         Sys::Rot => moment += f,
+                    }
+                }
+            }
+            // A controller with states of its own (an observer): its force on the hull.
+            if self.own_linear_dim > 0 {
+                for (k, w) in self.own_wrenches(fr, &z, &s.own) {
+                    if self.accounts[k].role == Role::Control {
+                        force += w[0];
+                        moment += w[1];
                     }
                 }
             }
