@@ -1289,3 +1289,59 @@ CATALOGUE += [
     Bad("observer with a key it does not take", _observer("wave_period = 9.0\n"), E,
         ("wave_period", "[observer]")),
 ]
+
+
+def _pipelay_lost(*lost: int, value: object = 300.0) -> Callable[[], object]:
+    def make():
+        from phsplit import scenario as scn
+
+        d = scn.load("pipelay").vessel.to_dict()
+        for i in lost:
+            d["thrusters"]["unit"][i]["lost_at"] = value
+        return phsplit.Vessel.from_dict(d)
+    return make
+
+
+def _footprint(**kw) -> Callable[[], object]:
+    def make():
+        from phsplit import dp
+
+        v = phsplit.Vessel.paper()
+        s = phsplit.simulate(v, (0.0, 4.0), 0.5, "sp2")
+        return dp.footprint(s, **{"vessel": v, **kw})
+    return make
+
+
+def _failures(**kw) -> Callable[[], object]:
+    def make():
+        from phsplit import dp
+        from phsplit import scenario as scn
+
+        sc = scn.load("pipelay")
+        return dp.single_failures(**{"vessel": sc.vessel, "settings": sc.settings, "at": 300.0, **kw})
+    return make
+
+
+CATALOGUE += [
+    # thruster failures and the DP footprint
+    Bad("thrusters lost that leave no surge", _pipelay_lost(2, 3), E,
+        ("thrusters.unit[*].lost_at", "thruster(s) 2, 3", "surge, sway and yaw")),
+    Bad("thruster lost at a time that is a word", _pipelay_lost(1, value="noon"), P,
+        ("thrusters.unit[1].lost_at", "number")),
+    Bad("footprint after a time given as a word", _footprint(after="late"), E,
+        ("footprint", "after", "finite time")),
+    Bad("footprint after the run's end", _footprint(after=10.0), E,
+        ("footprint", "fewer than two saved states", "ends at 4")),
+    Bad("footprint without a set point to measure from", _footprint(vessel=None), E,
+        ("footprint", "control.position_reference", "reference")),
+    Bad("footprint from a reference of two numbers", _footprint(reference=(780.0, 20.0)), E,
+        ("footprint", "reference must be 3 finite numbers")),
+    Bad("single failures after the run's end", _failures(at=5000.0), E,
+        ("single_failures", "at must be a time within", "[0, 3600)")),
+    Bad("single failures of a vessel without thrusters", _failures(vessel=phsplit.Vessel.paper()), E,
+        ("single_failures", "no [thrusters]")),
+    Bad("CLI: failures of a scenario without thrusters", cli("failures", "dp-weather", "--at", "5"), C,
+        ("single_failures", "no [thrusters]")),
+    Bad("CLI: failures without the time of the failure", cli("failures", "pipelay"), C,
+        ("--at",)),
+]

@@ -38,7 +38,8 @@ def vessels(draw):
     text = []
     for section in ("vessel", "control", "initial"):
         text.append(f"[{section}]")
-        text += [f"{k} = {[float(x) for x in val] if isinstance(val, list) else float(val)}"
+        text += [f'{k} = "{val}"' if isinstance(val, str) else
+                 f"{k} = {[float(x) for x in val] if isinstance(val, list) else float(val)}"
                  for k, val in d[section].items()]
     return phsplit.Vessel.from_toml_str("\n".join(text).replace("inf", "1e300"))
 

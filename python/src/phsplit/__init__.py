@@ -51,7 +51,7 @@ from ._core import (
     __version__,
 )
 from ._core import method_info as _method_info
-from . import events, hydro, pipe, results, rigid_body, sea, so3, special
+from . import dp, events, hydro, pipe, results, rigid_body, sea, so3, special
 from .batch import simulate_many, with_parameters
 from .capability import capability
 from .results import open_dataset, open_sweep, rerun
@@ -84,6 +84,7 @@ __all__ = [
     "Vessel",
     "__version__",
     "capability",
+    "dp",
     "events",
     "hydro",
     "load_scenario",

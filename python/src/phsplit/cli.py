@@ -186,6 +186,20 @@ def _parser() -> argparse.ArgumentParser:
     cp.add_argument("--tolerance", type=float, default=0.01, help="bisection tolerance in wind speed, m/s (default 0.01)")
     cp.add_argument("--out", default="out", help="output folder (default: ./out)")
     cp.add_argument("--no-plot", action="store_true", help="skip the PNG")
+    fa = sub.add_parser(
+        "failures",
+        help="the worst single thruster failure: the scenario run intact and with each thruster lost at a time",
+        description="Runs the scenario intact and with each of its thrusters lost at --at (thrusters.unit[i].lost_at: "
+        "from then the allocation redistributes the demand over the others) and prints, per case, the footprint "
+        "after the failure (largest and RMS excursion from the set point, heading deviation, thruster utilisation, "
+        "time saturated) and the worst case (docs/how-to/dp-failures.md).",
+        epilog="examples:\n  phsplit failures pipelay --at 600\n  phsplit failures pipelay --at 600 --t-end 1800",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    fa.add_argument("scenario", help="scenario TOML file or shipped scenario name whose vessel has [thrusters]")
+    fa.add_argument("--at", type=float, required=True, help="time of the failure, s, within the run")
+    fa.add_argument("--t-end", type=float, help="override the end time, s")
+    fa.add_argument("--vessel", help="use this vessel (a file or a shipped vessel's name) in the scenario")
     ra = sub.add_parser(
         "rao",
         help="motion RAOs in regular waves, time domain against the frequency domain of a Capytaine dataset",
@@ -748,6 +762,32 @@ def _fmu(args) -> int:
     return 0
 
 
+def _failures(args) -> int:
+    import dataclasses
+
+    from . import scenario as scn
+    from .dp import check_failure_study, single_failures
+
+    sc = scn.load(args.scenario, vessel=args.vessel)
+    st = sc.settings
+    if args.t_end is not None:
+        if not (math.isfinite(args.t_end) and args.t_end > st.t_span[0]):
+            raise UsageError(f"--t-end must be a finite time after the start ({st.t_span[0]:g} s), got {args.t_end:g}")
+        st = dataclasses.replace(st, t_span=(st.t_span[0], args.t_end))
+    n = len(check_failure_study(sc.vessel, st, args.at))
+    print(f"{sc.name}: {n + 1} runs on [{st.t_span[0]:g}, {st.t_span[1]:g}] s, each thruster lost in turn at "
+          f"t = {args.at:g} s", flush=True)
+    study = single_failures(sc.vessel, st, at=args.at)
+    print(study.table())
+    w = study.worst
+    if w is None:
+        print("no failure case completed", file=sys.stderr)
+        return 1
+    print(f"worst single failure: {w['case']} (largest excursion {w['max_excursion']:.3f} m after it, "
+          f"utilisation up to {w.get('utilisation_max', float('nan')):.3f})")
+    return 0
+
+
 def _capability(args) -> int:
     from . import scenario as scn
     from .capability import capability, polar_plot
@@ -970,6 +1010,8 @@ def main(argv: list[str] | None = None) -> int:
             return _capability(args)
         if args.command == "rao":
             return _rao(args)
+        if args.command == "failures":
+            return _failures(args)
         return _methods()
     except (UsageError, phsplit.InvalidInputError, phsplit.ScenarioParseError) as e:
         print(f"phsplit: error: {e}", file=sys.stderr)

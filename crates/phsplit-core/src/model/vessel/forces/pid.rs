@@ -313,7 +313,8 @@ impl Force for Pid {
     /// what they deliver in surge, sway and yaw, each thruster's thrust and angle, and the
     /// utilisation.
     fn outputs(&self, fr: &Frozen, z: &[Z3; 2], s: &VesselState, t: f64, out: &mut Vec<Output>) {
-        if let Some(th) = &self.thrusters {
+        if let Some(all) = &self.thrusters {
+            let th = all.at(t);
             let (f, m) = if fr.control_on {
                 self.demand(fr, t, z)
             } else {
@@ -353,6 +354,12 @@ impl Force for Pid {
                     "N",
                     format!("thrust of thruster {i} ({})", u.kind.name()),
                     a.thrust[i],
+                ));
+                out.push(Output::new(
+                    format!("thruster{i}_available"),
+                    "1",
+                    format!("whether thruster {i} delivers (0 once lost: its lost_at)"),
+                    f64::from(u8::from(all.available(i, t))),
                 ));
                 out.push(Output::new(
                     format!("thruster{i}_angle"),
@@ -433,7 +440,8 @@ impl Force for Pid {
                     g.force(Sys::Rot, Some(0), m.moment);
                 }
             }
-            Some(th) => {
+            Some(all) => {
+                let th = all.at(t);
                 let r = self.rows(fr);
                 let nu = fr.nu(z);
                 let (f, m) = Self::demand_of(&r, mv.as_ref(), &nu, z);
@@ -472,7 +480,7 @@ impl Force for Pid {
     /// controller is off).
     fn begin_memory(&self, fr: &Frozen, t: f64, z: &[Z3; 2], act: &mut Actuators) {
         if let Some(th) = &self.thrusters {
-            *act = th.memory_at(&self.demand_tau(fr, t, z), t);
+            *act = th.at(t).memory_at(&self.demand_tau(fr, t, z), t);
         }
     }
     fn check_memory(&self, act: &Actuators, t0: f64) -> crate::error::Result<()> {
@@ -483,7 +491,9 @@ impl Force for Pid {
     }
     fn end_step(&self, fr: &Frozen, t: f64, z: &[Z3; 2], act: &mut Actuators) {
         if let Some(th) = &self.thrusters {
-            *act = th.delivered(&self.demand_tau(fr, t, z), act, t - act.t);
+            *act = th
+                .at(t)
+                .delivered(&self.demand_tau(fr, t, z), act, t - act.t);
             act.t = t;
         }
     }

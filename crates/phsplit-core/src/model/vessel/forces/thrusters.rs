@@ -12,7 +12,11 @@
 //!     x towards y; default 90 for a tunnel, 0 for a fixed propeller);
 //!   - `weight` (> 0, default 1): the cost of its thrust in the allocation;
 //!   - `thrust_rate` (N/s, > 0, optional): the fastest change of its thrust; for an azimuth,
-//!     `turn_rate` (degrees/s, > 0, optional): its fastest turn.
+//!     `turn_rate` (degrees/s, > 0, optional): its fastest turn;
+//!   - `lost_at` (s, optional): a failure: from that time the thruster delivers nothing, at
+//!     once, and the allocation distributes the demand over the thrusters left (from the first
+//!     stage of flow S2 at or after that time; reported as `thruster<i>_available`). The
+//!     thrusters left must still produce surge, sway and yaw independently.
 //!
 //! **Allocation** (T. A. Johansen and T. I. Fossen, "Control allocation — a survey",
 //! *Automatica* 49 (2013) 1087–1103, §2.2; Fossen, *Handbook of Marine Craft Hydrodynamics and
@@ -99,6 +103,9 @@ pub struct Thrusters {
     vars: Vec<(usize, Vector2<f64>, Vector3<f64>)>,
     /// Each unit's variables, `vars[start..end]` (contiguous).
     ranges: Vec<(usize, usize)>,
+    /// From each time a thruster is lost (its `lost_at`), the allocation without it and those
+    /// lost before: each unit keeps its index, a lost one has no variables and delivers nothing.
+    after: Vec<(f64, Thrusters)>,
 }
 
 /// One allocation: what each thruster gives and what the vessel receives.
@@ -150,6 +157,7 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
         ));
     }
     let mut units = Vec::with_capacity(list.len());
+    let mut lost_at = Vec::with_capacity(list.len());
     let mut recorded = Vec::with_capacity(list.len());
     for (i, item) in list.iter().enumerate() {
         let name = format!("thrusters.unit[{i}]");
@@ -163,6 +171,7 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
         wrapped.insert(name.clone(), Value::Table(t.clone()));
         let mut sub = Params::from_table(wrapped);
         let unit = read_unit(&mut sub, &name, length, beam)?;
+        lost_at.push(sub.opt_f64(&name, "lost_at", "s", Range::Finite)?);
         // A key this kind does not read is refused, with the keys it does read.
         let out = sub.finish()?;
         if let Some(v) = out.get(&name) {
@@ -180,7 +189,7 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
             units.len()
         )));
     }
-    Thrusters::new(units).map(Some)
+    Thrusters::new(units)?.with_losses(&lost_at).map(Some)
 }
 
 fn read_unit(p: &mut Params, s: &str, length: f64, beam: f64) -> Result<Thruster> {
@@ -253,8 +262,19 @@ impl Thrusters {
     /// Precompute the weighted pseudo-inverse; the thrusters must be able to produce surge,
     /// sway and yaw independently (`B` of rank 3).
     pub fn new(units: Vec<Thruster>) -> Result<Self> {
+        let intact = vec![false; units.len()];
+        Self::without(units, &intact)
+    }
+
+    /// The allocation of `units` without those marked `lost` (which keep their index and
+    /// deliver nothing, at once: no rate limit holds them).
+    fn without(mut units: Vec<Thruster>, lost: &[bool]) -> Result<Self> {
         let mut cols: Vec<(usize, Vector2<f64>, Vector3<f64>, f64)> = Vec::new();
-        for (i, u) in units.iter().enumerate() {
+        for (i, u) in units.iter_mut().enumerate() {
+            if lost[i] {
+                (u.thrust_rate, u.turn_rate) = (None, None);
+                continue;
+            }
             let dirs: Vec<Vector2<f64>> = match u.kind {
                 Kind::Azimuth => vec![Vector2::new(1.0, 0.0), Vector2::new(0.0, 1.0)],
                 _ => vec![Vector2::new(u.angle.cos(), u.angle.sin())],
@@ -293,7 +313,46 @@ impl Thrusters {
             units,
             vars,
             ranges,
+            after: Vec::new(),
         })
+    }
+
+    /// With the losses of `lost_at` (one per unit, s; `None`: never lost): from each such time
+    /// the allocation redistributes the demand over the thrusters left.
+    pub fn with_losses(mut self, lost_at: &[Option<f64>]) -> Result<Self> {
+        let mut times: Vec<f64> = lost_at.iter().flatten().copied().collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        for tk in times {
+            let lost: Vec<bool> = lost_at.iter().map(|l| l.is_some_and(|t| t <= tk)).collect();
+            let left = Self::without(self.units.clone(), &lost).map_err(|e| {
+                let gone: Vec<String> = (0..lost.len())
+                    .filter(|i| lost[*i])
+                    .map(|i| i.to_string())
+                    .collect();
+                Error::InvalidInput(format!(
+                    "thrusters.unit[*].lost_at: with thruster(s) {} lost from t = {tk} s, {e}",
+                    gone.join(", ")
+                ))
+            })?;
+            self.after.push((tk, left));
+        }
+        Ok(self)
+    }
+
+    /// The allocation at time `t` (s): without the thrusters lost by then.
+    pub fn at(&self, t: f64) -> &Thrusters {
+        self.after
+            .iter()
+            .rev()
+            .find(|(tk, _)| t >= *tk)
+            .map_or(self, |(_, th)| th)
+    }
+
+    /// Whether thruster `i` still delivers at time `t`.
+    pub fn available(&self, i: usize, t: f64) -> bool {
+        let th = self.at(t);
+        th.ranges[i].0 < th.ranges[i].1
     }
 
     /// Thruster `i`'s unscaled force `(f_x, f_y)` for the demand `tau`, and its thrust along

@@ -1,0 +1,161 @@
+"""What a DP engineer reads of a run: the position and heading footprint about the set point, the
+thrusters' utilisation and time in saturation, and the worst single thruster failure of a
+scenario, found by running each one (docs/how-to/dp-failures.md).
+
+* :func:`footprint` summarises a :class:`~phsplit.Solution` of a vessel under DP control.
+* :func:`single_failures` runs a vessel intact and with each thruster lost at a time
+  (``thrusters.unit[i].lost_at``, docs/model.md §5.8), in parallel, and ranks the cases by their
+  largest excursion after the failure; the CLI is ``phsplit failures``.
+
+All numbers are over the saved states (``save_every`` decimates them): a peak between two saved
+states is not seen, and the time in saturation counts saved intervals."""
+from __future__ import annotations
+
+import concurrent.futures as futures
+import math
+import os
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from . import _core
+from .settings import Settings
+from .vessel import Vessel
+
+#: A thruster counts as saturated when the largest |thrust| over its limit reaches this.
+SATURATED = 1.0 - 1e-9
+
+
+def _reference(s, vessel: Vessel | None, reference: Sequence[float] | None) -> tuple[np.ndarray, np.ndarray]:
+    """The set point's x, y and heading at the saved times: the moving set point's outputs, the
+    given ``(x, y, heading)``, or the vessel's ``control`` table."""
+    n = len(s.t)
+    if "setpoint_x" in s.outputs and reference is None:
+        o = s.outputs
+        return np.column_stack([o["setpoint_x"][2], o["setpoint_y"][2]]), np.asarray(o["setpoint_heading"][2])
+    if reference is None:
+        if vessel is None:
+            raise _core.InvalidInputError("footprint: give the vessel (its control.position_reference and "
+                                          "euler_reference) or reference = (x, y, heading in rad)")
+        c = vessel.to_dict().get("control")
+        if c is None:
+            raise _core.InvalidInputError("footprint: the vessel has no [control] table: give reference = (x, y, heading)")
+        reference = (c["position_reference"][0], c["position_reference"][1], c["euler_reference"][2])
+    r = [float(v) for v in reference]
+    if len(r) != 3 or not all(math.isfinite(v) for v in r):
+        raise _core.InvalidInputError(f"footprint: reference must be 3 finite numbers (x m, y m, heading rad), got {reference!r}")
+    return np.tile(r[:2], (n, 1)), np.full(n, r[2])
+
+
+def footprint(s, vessel: Vessel | None = None, reference: Sequence[float] | None = None,
+              after: float = 0.0) -> dict[str, float]:
+    """The footprint of the run ``s`` from time ``after`` (s) on: the horizontal distance from the
+    set point (``max_excursion``, ``rms_excursion``, m; ``mean_offset_x``, ``mean_offset_y``, m,
+    spatial), the heading's deviation (``max_heading_deviation``, ``rms_heading_deviation``,
+    degrees, the short way round) and, with thrusters, their utilisation (the largest
+    |thrust| over its limit: ``utilisation_mean``, ``utilisation_p95``, ``utilisation_max``) and
+    the time they spent saturated (``time_saturated``, s, and ``fraction_saturated``)."""
+    if isinstance(after, bool) or not isinstance(after, (int, float)) or not math.isfinite(after):
+        raise _core.InvalidInputError(f"footprint: after must be a finite time in s, got {after!r}")
+    keep = np.asarray(s.t) >= after
+    if keep.sum() < 2:
+        raise _core.InvalidInputError(f"footprint: after = {after:g} s leaves fewer than two saved states "
+                                      f"(the run ends at {s.t[-1]:g} s)")
+    xy, psi = _reference(s, vessel, reference)
+    d = s.x[keep, :2] - xy[keep]
+    r = np.hypot(d[:, 0], d[:, 1])
+    dpsi = np.degrees((s.euler[keep, 2] - psi[keep] + math.pi) % (2 * math.pi) - math.pi)
+    out = {"max_excursion": float(r.max()), "rms_excursion": float(np.sqrt(np.mean(r ** 2))),
+           "mean_offset_x": float(d[:, 0].mean()), "mean_offset_y": float(d[:, 1].mean()),
+           "max_heading_deviation": float(np.abs(dpsi).max()),
+           "rms_heading_deviation": float(np.sqrt(np.mean(dpsi ** 2)))}
+    if "thrust_utilisation" in s.outputs:
+        u = np.asarray(s.outputs["thrust_utilisation"][2])[keep]
+        t = np.asarray(s.t)[keep]
+        dt = np.diff(t)
+        sat = (u[1:] >= SATURATED) & (u[:-1] >= SATURATED)
+        span = float(t[-1] - t[0])
+        out.update(utilisation_mean=float(u.mean()), utilisation_p95=float(np.percentile(u, 95)),
+                   utilisation_max=float(u.max()), time_saturated=float(dt[sat].sum()),
+                   fraction_saturated=float(dt[sat].sum() / span) if span > 0 else 0.0)
+    return out
+
+
+@dataclass
+class FailureStudy:
+    """The cases of :func:`single_failures`: ``rows`` (one dict per case: ``case``, ``lost``
+    (the thruster's index, or None), ``status``, ``error`` and the :func:`footprint` after the
+    failure) and ``worst``, the completed failure case with the largest excursion."""
+
+    at: float
+    rows: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def worst(self) -> dict[str, Any] | None:
+        """The completed failure case with the largest excursion after the failure; between
+        excursions within a millimetre, the one whose thrusters come closest to their limits
+        (the least capacity left)."""
+        failed = [r for r in self.rows if r["lost"] is not None and r["status"] == "completed"]
+        return max(failed, key=lambda r: (round(r["max_excursion"], 3), r.get("utilisation_max", 0.0)), default=None)
+
+    def table(self) -> str:
+        """The cases as a Markdown table."""
+        lines = ["| case | status | max excursion (m) | RMS (m) | max heading dev. (deg) | max utilisation | saturated (s) |",
+                 "|---|---|---|---|---|---|---|"]
+        for r in self.rows:
+            if r["status"] != "completed":
+                lines.append(f"| {r['case']} | {r['status']}: {r['error']} | | | | | |")
+                continue
+            lines.append(f"| {r['case']} | completed | {r['max_excursion']:.3f} | {r['rms_excursion']:.3f} | "
+                         f"{r['max_heading_deviation']:.3f} | {r.get('utilisation_max', float('nan')):.3f} | "
+                         f"{r.get('time_saturated', 0.0):.1f} |")
+        return "\n".join(lines)
+
+
+def check_failure_study(vessel: Vessel, settings: Settings, at: float) -> list:
+    """What :func:`single_failures` refuses, before anything runs: its thruster units."""
+    if not isinstance(vessel, Vessel):
+        raise _core.InvalidInputError(f"single_failures: vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
+    if not isinstance(settings, Settings):
+        raise _core.InvalidInputError(f"single_failures: settings must be a phsplit.Settings, got {type(settings).__name__}")
+    d = vessel.to_dict()
+    units = d.get("thrusters", {}).get("unit")
+    if not units:
+        raise _core.InvalidInputError("single_failures: the vessel has no [thrusters] to lose")
+    t0, t1 = settings.t_span
+    if isinstance(at, bool) or not isinstance(at, (int, float)) or not (t0 <= at < t1):
+        raise _core.InvalidInputError(f"single_failures: at must be a time within the run's t_span [{t0:g}, {t1:g}) s, got {at!r}")
+
+    return units
+
+
+def single_failures(vessel: Vessel, settings: Settings, at: float, max_workers: int | None = None) -> FailureStudy:
+    """Run ``vessel`` with ``settings`` intact and with each of its thrusters lost at ``at`` (s) in
+    turn (``thrusters.unit[i].lost_at``, any it already has kept), on a thread pool, and take
+    each case's :func:`footprint` from ``at`` on. A case the allocation cannot take (the thrusters
+    left cannot produce surge, sway and yaw) or whose run fails is listed with its error."""
+    units = check_failure_study(vessel, settings, at)
+
+    def one(lost):
+        case = "intact" if lost is None else f"thruster {lost} lost"
+        row = {"case": case, "lost": lost, "status": "invalid", "error": ""}
+        dd = vessel.to_dict()
+        if lost is not None:
+            dd["thrusters"]["unit"][lost]["lost_at"] = float(at)
+        try:
+            v = Vessel.from_dict(dd)
+        except (_core.InvalidInputError, _core.ScenarioParseError) as e:
+            row["error"] = str(e)
+            return row
+        s = settings.run(v)
+        row["status"] = s.status
+        row["error"] = s.failure or ""
+        if s.status == "completed":
+            row.update(footprint(s, vessel=v, after=at))
+        return row
+
+    cases = [None] + list(range(len(units)))
+    with futures.ThreadPoolExecutor(max_workers=max_workers or os.cpu_count() or 2) as pool:
+        rows = list(pool.map(one, cases))
+    return FailureStudy(at=float(at), rows=rows)
