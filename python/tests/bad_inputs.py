@@ -987,6 +987,20 @@ CATALOGUE += [
 # the static DP capability (phsplit.capability, phsplit capability)
 
 
+def _hold(**kw) -> Callable[[], object]:
+    from phsplit.capability import hold
+
+    return lambda: hold("dp-capability", **{"direction": 90.0, "wind_speed": 10.0, **kw})
+
+
+def _hold_external() -> object:
+    from phsplit.capability import hold
+
+    t = phsplit.load_scenario("dp-capability").vessel.to_dict()
+    t["external"] = {"force": [1.0, 0.0, 0.0]}
+    return hold(phsplit.Vessel.from_dict(t), 90.0, 10.0)
+
+
 def _cap(**kw) -> Callable[[], object]:
     return lambda: phsplit.capability("dp-capability", **{"directions": [0.0], "failures": "none", **kw})
 
@@ -1029,6 +1043,12 @@ CATALOGUE += [
         C, ("dp-capability-capability.nc", "folder of that name")),
     Bad("CLI: capability with a step that does not divide 360", cli("capability", "dp-capability", "--step", "7"), C,
         ("--step", "divide 360", "7")),
+    Bad("capability time-domain check of a thruster that does not exist", _hold(lost=[4]), E,
+        ("lost", "0..3", "[4]")),
+    Bad("capability time-domain check at a negative wind speed", _hold(wind_speed=-5.0), E, ("wind_speed", "[0, 80]")),
+    Bad("capability time-domain check of no duration", _hold(t_end=0.0), E, ("t_end", "(0, 86400]")),
+    Bad("capability time-domain check of a vessel with an external load", _hold_external, E,
+        ("[external]", "mean wave drift")),
 ]
 
 # ------------------------------------------------------------------------------------------

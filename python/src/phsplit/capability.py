@@ -462,6 +462,91 @@ def capability(vessel: Any, directions: Any = None, failures: Any = "single",
     return cf.finish(ds, "phsplit DP capability (static, level 1)", "phsplit.capability")
 
 
+def hold(vessel: Any, direction: float, wind_speed: float, lost: Sequence[int] = (),
+         environment: Sequence[Sequence[float]] = LEVEL1, t_end: float = 1200.0, h: float = 0.5,
+         method: str = "sp2"):
+    """A time-domain check of one point of a capability plot: the vessel under its controller
+    and thrusters, ``lost`` thrusters lost from the start, in the mean environment of wind speed
+    ``wind_speed`` (m/s; its current and sea state from ``environment``, as :func:`capability`)
+    coming from ``direction`` (degrees off the bow, clockwise). The loads are those of the static
+    balance, acting on the moving vessel: the steady wind and the current through the core's
+    components, and the mean wave drift of the sea state as a constant body-frame load
+    (``[external]``; the first-order waves and the slowly varying drift are left out, as in the
+    static balance). The run starts on the set point at rest, with the controller's integral
+    states already balancing the load (the vessel has been holding station in this weather);
+    the thrusters then deliver what they can. Returns ``(solution, excursion)``: the
+    :class:`Solution` and the horizontal distance from the set point at each saved time (m).
+
+    Where the thrusters can balance the load (at or below the static limit) the vessel stays on
+    its set point; beyond it they saturate and the vessel is pushed off (test_osv_capability.py).
+    """
+    from .scenario import Scenario, load
+    from .simulate import simulate
+
+    if isinstance(vessel, (str,)) or hasattr(vessel, "__fspath__"):
+        vessel = load(vessel).vessel
+    elif isinstance(vessel, Scenario):
+        vessel = vessel.vessel
+    if not isinstance(vessel, Vessel):
+        _bad("vessel", f"must be a phsplit.Vessel, a Scenario, or a scenario file or name, got {type(vessel).__name__}")
+    d = float(_directions([direction])[0])
+    if not (isinstance(wind_speed, (int, float, np.integer, np.floating)) and not isinstance(wind_speed, (bool, np.bool_))
+            and 0.0 <= float(wind_speed) <= MAX_WIND):
+        _bad("wind_speed", f"must be a number in [0, {MAX_WIND:g}] m/s, got {wind_speed!r}")
+    if not (isinstance(t_end, (int, float)) and not isinstance(t_end, bool) and math.isfinite(t_end)
+            and 0.0 < t_end <= 86400.0):
+        _bad("t_end", f"must be a number in (0, 86400] s, got {t_end!r}")
+    env = Environment(environment)
+    loads = _Loads(vessel)
+    tables = vessel.to_dict()
+    if "control" not in tables:
+        _bad("vessel", "has no [control] table: the time-domain check needs the controller that holds the set point")
+    if "external" in tables:
+        _bad("vessel", "has an [external] load; the check books the mean wave drift there: remove it")
+    if tables["control"].get("feedback", "true_state") != "true_state":
+        _bad("vessel", "acts on observer estimates; the check starts the controller's integral states balanced, "
+             "which needs control.feedback = \"true_state\"")
+    if isinstance(lost, (str, bytes, Mapping)) or not isinstance(lost, (Sequence, np.ndarray)):
+        _bad("lost", f"must be a list of thruster indices, got {lost!r}")
+    n_units = len(_core.thruster_units(vessel._inner))
+    if not all(isinstance(i, (int, np.integer)) and not isinstance(i, (bool, np.bool_)) and 0 <= int(i) < n_units
+               for i in lost) or len(set(int(i) for i in lost)) != len(lost):
+        _bad("lost", f"must be distinct thruster indices 0..{n_units - 1} (the vessel has {n_units}), got {list(lost)!r}")
+    lost_ = sorted(int(i) for i in lost)
+    u = float(wind_speed)
+    hs, tp, vc = env.at(u)
+    towards = _towards(math.degrees(loads.heading), d)
+    load_ = loads.total(env, u, towards)
+    drift = loads.drift(hs, tp, towards)[0]
+    t = copy.deepcopy(tables)
+    t.pop("waves", None)
+    for k in ("gust_frequencies", "gust_amplitudes", "gust_phases"):
+        t["wind"].pop(k, None)
+    a = math.radians(towards)
+    t["wind"].update(speed=u, direction=towards)
+    t["current"] = {"velocity": [vc * math.cos(a), vc * math.sin(a), 0.0]}
+    t["external"] = {"force": [float(drift[0]), float(drift[1]), 0.0], "moment": [0.0, 0.0, float(drift[2])]}
+    for i in lost_:
+        t["thrusters"]["unit"][i]["lost_at"] = 0.0
+    run_vessel = Vessel.from_dict(t, vessel.source)
+    y0 = np.array(run_vessel._inner.initial_state(velocity=[0.0] * 3, angular_velocity=[0.0] * 3), dtype=float)
+    # The integral states holding the load (docs/explanation/vessel.md §2.6; forces/pid.rs): at rest on
+    # the set point the controller's force is -Q^T Ki phi_x and its yaw moment -Ki psi phi_th.
+    c = t["control"]
+    ki_t, ki_r = np.asarray(c["ki_translational"], float), np.asarray(c["ki_rotational"], float)
+    if ki_t[0] <= 0 or ki_t[1] <= 0 or ki_r[2] <= 0:
+        _bad("vessel", "needs integral gains in surge, sway and yaw (control.ki_translational, ki_rotational) "
+             "for a controller that holds a mean load on the set point")
+    ref = np.asarray(c["position_reference"][:2], float)
+    y0[18:20] = ref
+    q = y0[6:15].reshape(3, 3, order="F")
+    phi = q @ np.array([load_[0], load_[1], 0.0])
+    y0[24:26] = phi[:2] / ki_t[:2]
+    y0[23] = load_[2] / ki_r[2]
+    sol = simulate(run_vessel, (0.0, float(t_end)), h, method, control_start=0.0, initial=y0)
+    return sol, np.hypot(*(sol.x[:, :2] - ref).T)
+
+
 def polar_plot(ds, path: str, title: str | None = None) -> None:
     """Draw a capability dataset's wind speed limits as a polar plot (0 from ahead, clockwise)."""
     import matplotlib

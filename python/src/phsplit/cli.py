@@ -171,7 +171,7 @@ def _parser() -> argparse.ArgumentParser:
         "sea state and current), the largest wind speed whose mean load the thrusters can balance within their "
         "limits (the core's allocation), intact and with each single thruster lost. Writes <out>/<name>-capability.nc "
         "and a polar plot <out>/<name>-capability.png (docs/how-to/dp-capability.md).",
-        epilog="examples:\n  phsplit capability dp-capability\n  phsplit capability my-scenario.toml --step 15 --out cap/\n"
+        epilog="examples:\n  phsplit capability dp-capability\n  phsplit capability osv-capability\n  phsplit capability my-scenario.toml --step 15 --out cap/\n"
         "  phsplit capability dp-capability --directions 0 90 180 270 --failures none",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
