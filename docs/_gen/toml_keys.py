@@ -68,6 +68,17 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "initial_estimate": ("m, m, rad", "the measured", "initial `(x̂, ŷ, ψ̂)`"),
         "initial_bias": ("N, N, N m", "[0, 0, 0]", "initial bias estimate, spatial frame"),
     },
+    "sensors": {
+        "gnss_rate": ("Hz", REQ, "the GNSS position's sample rate, in (0, 1000]; samples held between (§5.20, *Sensors*)"),
+        "gyro_rate": ("Hz", REQ, "the gyro heading's sample rate, in (0, 1000]"),
+        "gnss_noise": ("m", "0", "standard deviation of the white noise on each horizontal axis, in [0, 100]"),
+        "gnss_bias": ("m", "[0, 0]", "constant bias of the position, spatial x and y, each within ±1000"),
+        "gyro_noise": ("rad", "0", "standard deviation of the white noise on the heading, in [0, 0.5]"),
+        "gyro_bias": ("rad", "0", "constant bias of the heading, within ±0.5"),
+        "gnss_dropout": ("s", "none", "rows `[start, end]` in time order: the receiver delivers nothing in between"),
+        "gyro_dropout": ("s", "none", "rows `[start, end]`: the gyro delivers nothing in between"),
+        "seed": ("-", "0", "whole number ≥ 0: the noise of sample k is drawn from (seed, sensor, k)"),
+    },
     "external": {
         "force": ("N", "[0, 0, 0]", "constant force (§5.4)"),
         "moment": ("N m", "[0, 0, 0]", "constant moment"),
@@ -261,6 +272,7 @@ SOURCE = {
     "damping_quadratic": "`forces/damping_quadratic.rs`",
     "roll_damping": "`forces/roll_damping.rs`",
     "observer": "`forces/observer.rs`",
+    "sensors": "`forces/sensors.rs`",
     "crossflow_drag": "`forces/crossflow.rs`",
     "pipe": "`forces/pipe.rs`",
     "pipe.lumped_mass": "`forces/pipe/lumped.rs`",
@@ -303,7 +315,7 @@ def accepted() -> dict[str, set[str]]:
                 {**paper, "external": {"force": [1.0, 0.0, 0.0]},
                  "damping_quadratic": {"coefficients": [0.0] * 6},
                  "roll_damping": {"critical_fraction": 0.05}},
-                _examples()["observer"],
+                _examples()["observer"], _examples()["sensors"],
                 _examples()["spring"], _examples()["port_hamiltonian"]]
     out: dict[str, set[str]] = {}
     for table in _core.vessel_tables():
@@ -343,6 +355,9 @@ def _examples() -> dict[str, dict]:
             "roll_damping": {**paper, "roll_damping": {"critical_fraction": 0.05, "quadratic": 1.0e9}},
             "observer": {**paper, "control": {**paper["control"], "feedback": "observer"},
                          "observer": {"wave_frequency": 0.7, "damping": [3.5e4, 1.2e5, 3.2e8]}},
+            "sensors": {**paper, "control": {**paper["control"], "feedback": "observer"},
+                        "observer": {"wave_frequency": 0.7, "damping": [3.5e4, 1.2e5, 3.2e8]},
+                        "sensors": {"gnss_rate": 1.0, "gyro_rate": 10.0}},
             "spring": {**paper, "spring": {"fairlead": [30.0, 0.0, 0.0], "anchor": [700.0, 0.0, -5.0], "stiffness": 1.0e4}},
             "port_hamiltonian": {**paper, "port_hamiltonian": {
                 "name": "port_hamiltonian", "states": ["q", "p"], "units": ["1", "1"], "J": [[0.0, 1.0], [-1.0, 0.0]],
@@ -477,7 +492,7 @@ def render() -> str:
         ("Scenario files", ["simulation", "environment.waves", "environment.wind"]),
         ("Vessel files (and any scenario, table by table)",
          ["vessel", "initial", "control", "external", "current", "damping_quadratic", "roll_damping", "crossflow_drag",
-          "observer", "pipe", "pipe.lumped_mass", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
+          "observer", "sensors", "pipe", "pipe.lumped_mass", "setpoint", "thrusters", "thrusters.unit", "waves", "wind"]),
         ("Sweep files", ["sweep"]),
     ]
     for title, tables in groups:

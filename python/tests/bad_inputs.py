@@ -1311,6 +1311,43 @@ CATALOGUE += [
 ]
 
 
+
+def _sensors(body: str, observer: bool = True) -> Callable[[], object]:
+    table = "[sensors]\n" + body
+    if observer:
+        return vessel_with("[control]\n", _OBS + table + '\n[control]\nfeedback = "observer"\n')
+    return vessel_with("[control]\n", table + "\n[control]\n")
+
+
+_RATES = "gnss_rate = 1.0\ngyro_rate = 10.0\n"
+
+CATALOGUE += [
+    # the sensors the observer reads
+    Bad("sensors without the observer that reads them", _sensors(_RATES, observer=False), E,
+        ("[sensors]", "control.feedback", "observer")),
+    Bad("sensors without a GNSS sample rate", _sensors("gyro_rate = 10.0\n"), E, ("sensors.gnss_rate",)),
+    Bad("sensors sampling at no rate", _sensors("gnss_rate = 0.0\ngyro_rate = 10.0\n"), E,
+        ("sensors.gnss_rate", "> 0")),
+    Bad("sensors sampling 5000 times a second", _sensors("gnss_rate = 1.0\ngyro_rate = 5000.0\n"), E,
+        ("sensors.gyro_rate", "1000")),
+    Bad("GNSS noise of a negative standard deviation", _sensors(_RATES + "gnss_noise = -0.5\n"), E,
+        ("sensors.gnss_noise", "[0, 100]")),
+    Bad("gyro bias in degrees", _sensors(_RATES + "gyro_bias = 2.0\n"), E,
+        ("sensors.gyro_bias", "degrees")),
+    Bad("GNSS bias of three numbers", _sensors(_RATES + "gnss_bias = [0.1, 0.2, 0.3]\n"), E,
+        ("sensors.gnss_bias", "2 numbers")),
+    Bad("sensor dropout that ends before it starts", _sensors(_RATES + "gnss_dropout = [[60.0, 30.0]]\n"), E,
+        ("sensors.gnss_dropout[0]", "end > start")),
+    Bad("sensor dropouts that overlap", _sensors(_RATES + "gyro_dropout = [[10.0, 30.0], [20.0, 40.0]]\n"), E,
+        ("sensors.gyro_dropout[1]", "time order")),
+    Bad("sensor dropout as a single pair of times", _sensors(_RATES + "gnss_dropout = [10.0, 20.0]\n"), E,
+        ("sensors.gnss_dropout", "rows of 2")),
+    Bad("sensor seed that is negative", _sensors(_RATES + "seed = -1\n"), E, ("sensors.seed", "whole number")),
+    Bad("sensor seed that is not whole", _sensors(_RATES + "seed = 1.5\n"), E, ("sensors.seed", "whole number")),
+    Bad("sensors with a key they do not take", _sensors(_RATES + "gnss_nosie = 0.5\n"), E,
+        ("gnss_nosie", "gnss_noise")),
+]
+
 def _pipelay_lost(*lost: int, value: object = 300.0) -> Callable[[], object]:
     def make():
         from phsplit import scenario as scn

@@ -456,7 +456,10 @@ impl Params {
     pub fn missing(&self, section: &str, key: &str, unit: &str) -> Error {
         if let Some(Value::Table(t)) = self.input.get(section) {
             let want = [key.to_string()];
-            if let Some(typo) = t.keys().find(|k| nearest(k, &want).is_some()) {
+            let taken = self.taken.get(section);
+            let read = |k: &String| taken.is_some_and(|t| t.iter().any(|x| x == k));
+            // A key another getter read is no misspelling of this one.
+            if let Some(typo) = t.keys().find(|k| !read(k) && nearest(k, &want).is_some()) {
                 let mut valid = self.taken.get(section).cloned().unwrap_or_default();
                 valid.retain(|k| k != typo);
                 return Error::Parse(unknown(typo, &valid, "field", &format!("[{section}]")));

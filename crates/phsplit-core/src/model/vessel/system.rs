@@ -109,6 +109,8 @@ pub struct VesselSystem<'a> {
     own_linear_dim: usize,
     /// Each component with a flow of its own: its index and its range in [`VesselState::own`].
     own_flowing: Vec<(usize, std::ops::Range<usize>)>,
+    /// Where in [`VesselState::own`] the sensors' held measurements are ([`Frozen::held`]).
+    held: Option<std::ops::Range<usize>>,
     /// The exact flow S2's balance beyond the structural one, per controller state and block
     /// system: computed once, at the upright attitude (`s2.rs`, `exact_balance`).
     exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
@@ -167,6 +169,9 @@ impl<'a> VesselSystem<'a> {
             own_linear_dim: linear.iter().map(|p| p.1.len()).sum(),
             own_parts: linear,
             own_flowing: own::flowing_of(vessel),
+            held: vessel
+                .own_layout()
+                .find_map(|(f, r)| f.held_states().map(|h| r.start + h.start..r.start + h.end)),
             exact_balance: Default::default(),
             s2_memo: Default::default(),
             accounts,
@@ -265,7 +270,17 @@ impl<'a> VesselSystem<'a> {
         let mut fr = self.frozen_at(&s.q, on);
         fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
         fr.actuators = s.act;
+        fr.held = self.held_of(s);
         fr
+    }
+
+    /// The sensors' measurements held at `s` ([`Frozen::held`]).
+    pub(super) fn held_of(&self, s: &VesselState) -> Option<[f64; super::forces::HELD]> {
+        self.held.as_ref().map(|r| {
+            let mut a = [0.0; super::forces::HELD];
+            a.copy_from_slice(&s.own[r.clone()]);
+            a
+        })
     }
 
     /// The frozen view at the attitude `q`, the vessel at rest.
@@ -283,6 +298,7 @@ impl<'a> VesselSystem<'a> {
             body: &self.vessel.body,
             velocity: [Vector3::zeros(); 2],
             actuators: Default::default(),
+            held: None,
         }
     }
 
@@ -478,17 +494,27 @@ impl Model for VesselSystem<'_> {
     /// Rate-limited thrusters: start their memory with what they deliver at `t0`, unless the
     /// state brings it (a run continued from an earlier call's last state).
     fn begin(&self, t0: f64, s: &mut VesselState) {
+        // Sensors take their first samples where the run starts (a continued run keeps its own).
+        for (i, r, _) in &self.own_parts {
+            if self.vessel.forces[*i].held_states().is_some() {
+                let mut x = s.own[r.clone()].to_vec();
+                self.vessel.forces[*i].own_end_step(t0, s, &mut x);
+                s.own[r.clone()].copy_from_slice(&x);
+            }
+        }
         if self.actuators > 0 && s.act.n != self.actuators {
             self.update_memory(s, self.control_on(t0), |f, fr, z, act| {
                 f.begin_memory(fr, t0, z, act)
             });
         }
     }
-    /// Rate-limited thrusters: record what they deliver at the end of the step.
+    /// The components' own states' updates at the end of the step (a pipe's drift correction,
+    /// the sensors' samples); rate-limited thrusters: record what they deliver.
     fn end_step(&self, t_step: f64, t1: f64, s: &mut VesselState) {
-        for (i, r) in &self.own_flowing {
+        let parts = self.own_parts.iter().map(|(i, r, _)| (i, r));
+        for (i, r) in self.own_flowing.iter().map(|(i, r)| (i, r)).chain(parts) {
             let mut x = s.own[r.clone()].to_vec();
-            self.vessel.forces[*i].own_end_step(s, &mut x);
+            self.vessel.forces[*i].own_end_step(t1, s, &mut x);
             s.own[r.clone()].copy_from_slice(&x);
         }
         if self.actuators > 0 {

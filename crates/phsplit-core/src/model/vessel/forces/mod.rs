@@ -45,7 +45,7 @@ use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use std::sync::Arc;
 
-pub use own::{OwnLinear, OwnState};
+pub use own::{Output, OwnLinear, OwnState};
 
 pub mod crossflow;
 pub mod current;
@@ -59,6 +59,7 @@ pub mod pipe;
 pub mod port_hamiltonian;
 pub mod restoring;
 pub mod roll_damping;
+mod sensors;
 mod setpoint;
 pub mod spring;
 pub mod thrusters;
@@ -83,7 +84,7 @@ pub const COMPONENTS: &[(&str, &[&str], Build)] = &[
     ("restoring", &["vessel"], restoring::build),
     (
         "pid",
-        &["control", "setpoint", "thrusters", "observer"],
+        &["control", "setpoint", "thrusters", "observer", "sensors"],
         pid::build,
     ),
     ("external", &["external"], external::build),
@@ -179,7 +180,13 @@ pub struct Frozen<'a> {
     /// What rate-limited thrusters delivered at the end of the last step (none for other
     /// vessels, and in a view at rest).
     pub actuators: Actuators,
+    /// The measurements sensors hold over the step ([`Force::held_states`]; `None` in a view
+    /// at rest and for a vessel without sensors).
+    pub held: Option<[f64; HELD]>,
 }
+
+/// How many numbers the sensors hold over a step (`sensors.rs`).
+pub const HELD: usize = 5;
 
 impl Frozen<'_> {
     /// The body velocities `ν = M⁻¹u` (linear, angular) at the block states `z`.
@@ -434,31 +441,6 @@ impl Forcing {
     }
 }
 
-/// A named scalar a component reports at a state, for the results (CF units).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Output {
-    pub name: String,
-    pub unit: &'static str,
-    pub long_name: String,
-    pub value: f64,
-}
-
-impl Output {
-    pub fn new(
-        name: impl Into<String>,
-        unit: &'static str,
-        long_name: impl Into<String>,
-        value: f64,
-    ) -> Self {
-        Self {
-            name: name.into(),
-            unit,
-            long_name: long_name.into(),
-            value,
-        }
-    }
-}
-
 /// A force or port of the vessel. See the module documentation for the contract.
 pub trait Force: Debug + Send + Sync {
     /// The component's name (its registration name).
@@ -559,10 +541,16 @@ pub trait Force: Debug + Send + Sync {
     fn own_hull_account(&self) -> Option<usize> {
         None
     }
-    /// Update, at the end of every step, what its own flow holds constant over the next step
-    /// from the body's state `s` and its own states `x` there (where both are synchronised:
-    /// inside a step the sub-flows have moved them by different parts of it).
-    fn own_end_step(&self, _s: &VesselState, _x: &mut [f64]) {}
+    /// Update, at the end of every step (time `t`) and where a run starts, what its own states
+    /// hold constant over the next step from the body's state `s` and its own states `x` there
+    /// (where both are synchronised: inside a step the sub-flows have moved them by different
+    /// parts of it): a pipe's drift correction, the sensors' samples.
+    fn own_end_step(&self, _t: f64, _s: &VesselState, _x: &mut [f64]) {}
+    /// Which of its own states (a range of [`HELD`] in its own states) are measurements held
+    /// over a step, which the frozen view carries ([`Frozen::held`]).
+    fn held_states(&self) -> Option<std::ops::Range<usize>> {
+        None
+    }
     /// Set its own states `x` from the body's state `s` where a run starts (the pipe's static
     /// shape under the hang-off point); by default they keep their declared initial values.
     fn init_own(&self, _s: &VesselState, _x: &mut [f64]) -> Result<()> {

@@ -39,7 +39,8 @@
 //! exactly along the flow. The guarantee is the paper's for a port: the vessel's energy
 //! changes by what the ports supply less what it dissipates, to round-off.
 
-use super::{Frozen, Output, OwnLinear, OwnState};
+use super::sensors::{self, Sensors};
+use super::{Frozen, Output, OwnLinear, OwnState, HELD};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::vessel::params::{Params, Range};
@@ -84,6 +85,9 @@ pub struct Observer {
     states: Vec<OwnState>,
     /// The rows at heading 0 (their shape; the vessel's layout reads it).
     template: OwnLinear,
+    /// The sensors it reads (`sensors.rs`); `None`: the vessel's position and heading,
+    /// continuously.
+    sensors: Option<Sensors>,
 }
 
 /// The controller's gains in the horizontal plane, with its set point.
@@ -198,6 +202,7 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
         )
     })?;
     let pick = |a: &[Vector3<f64>; 2]| Vector3::new(a[0].x, a[0].y, a[1].z);
+    let sensors = sensors::read(p)?;
     let mut o = Observer {
         omega0,
         lambda,
@@ -219,7 +224,8 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
         ),
         initial_eta,
         initial_bias,
-        states: states(),
+        states: states(sensors.is_some()),
+        sensors,
         template: OwnLinear::exchange(
             DMatrix::zeros(N, N),
             DMatrix::zeros(N, 6),
@@ -229,7 +235,7 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
             DMatrix::zeros(N + 6, N + 6),
         ),
     };
-    o.template = o.rows(0.0, true);
+    o.template = o.rows(0.0, true, None);
     Ok(o)
 }
 
@@ -265,8 +271,8 @@ fn gains(
     Ok((k4.unwrap_or(p4), k3.unwrap_or(p3)))
 }
 
-fn states() -> Vec<OwnState> {
-    let mut out = Vec::with_capacity(N);
+fn states(sensed: bool) -> Vec<OwnState> {
+    let mut out = Vec::with_capacity(N + sensors::N);
     let mut push = |name: &str, unit: &str, long: &str| {
         out.push(OwnState {
             name: name.into(),
@@ -333,6 +339,11 @@ fn states() -> Vec<OwnState> {
             &format!("integral of the estimated error in {d} (the controller's I term)"),
         );
     }
+    if sensed {
+        for (name, unit, long) in Sensors::states() {
+            push(name, unit, long);
+        }
+    }
     out
 }
 
@@ -355,26 +366,43 @@ impl Observer {
         self.reference.z + super::pid::wrap_pi(psi - self.reference.z)
     }
 
-    /// The rows at the measured heading `psi`; `on`: the controller acts.
-    pub fn rows(&self, psi: f64, on: bool) -> OwnLinear {
-        let psi_u = self.heading(psi);
+    /// How many own states: the observer's, and the sensors' after them.
+    fn n(&self) -> usize {
+        N + self.sensors.as_ref().map_or(0, |_| sensors::N)
+    }
+
+    /// The rows at the measured heading `psi`; `on`: the controller acts; `held`: the sensors'
+    /// held measurement `(x, y, ψ)` and validities ([`Frozen::held`]), or `None` for the
+    /// vessel's position and heading measured continuously.
+    pub fn rows(&self, psi: f64, on: bool, held: Option<&[f64; HELD]>) -> OwnLinear {
+        let n = self.n();
         let r = rot(psi);
         let rt = r.transpose();
-        let mut axx = DMatrix::zeros(N, N);
-        let mut axv = DMatrix::zeros(N, 3);
-        let mut axc = DVector::zeros(N);
-        // ỹ = Y_v v + y_c − η̂ − ξ̂₂ (rows of 3 on x, v and the constant).
-        let mut yx = DMatrix::<f64>::zeros(3, N);
+        let mut axx = DMatrix::zeros(n, n);
+        let mut axv = DMatrix::zeros(n, 3);
+        let mut axc = DVector::zeros(n);
+        // ỹ = S (Y_v v + y_c − η̂ − ξ̂₂) (rows of 3 on x, v and the constant), S the sensors'
+        // validities: continuously measured, y = v + x_o (x_o enters the constant in `rows_at`)
+        // and ψ; sampled, the held measurement, a constant over the step.
+        let mut yx = DMatrix::<f64>::zeros(3, n);
         let mut yv = DMatrix::<f64>::zeros(3, 3);
-        let yc = Vector3::new(0.0, 0.0, psi_u);
+        let (yc, mask) = match held {
+            None => {
+                yv[(0, 0)] = 1.0;
+                yv[(1, 1)] = 1.0;
+                (Vector3::new(0.0, 0.0, self.heading(psi)), [1.0, 1.0, 1.0])
+            }
+            Some(h) => (
+                Vector3::new(h[0], h[1], self.heading(h[2])),
+                [h[3], h[3], h[4]],
+            ),
+        };
         for i in 0..3 {
-            yx[(i, ETA + i)] = -1.0;
-            yx[(i, XI2 + i)] = -1.0;
+            yx[(i, ETA + i)] = -mask[i];
+            yx[(i, XI2 + i)] = -mask[i];
         }
-        yv[(0, 0)] = 1.0;
-        yv[(1, 1)] = 1.0;
-        // The position measured is v + x_o: x_o enters the constant in `rows_at`.
-        let yc = DVector::from_column_slice(yc.as_slice());
+        let yc = Vector3::from_fn(|i, _| mask[i] * yc[i]);
+        let yc_n = DVector::from_column_slice(yc.as_slice());
         let add_y = |axx: &mut DMatrix<f64>,
                      axv: &mut DMatrix<f64>,
                      axc: &mut DVector<f64>,
@@ -386,7 +414,7 @@ impl Observer {
             let mut rows = axv.rows_mut(row, 3);
             rows += &k * &yv;
             let mut rows = axc.rows_mut(row, 3);
-            rows += &k * &yc;
+            rows += &k * &yc_n;
         };
         let w2 = self.omega0 * self.omega0;
         for i in 0..3 {
@@ -413,7 +441,7 @@ impl Observer {
             }
         }
         // The controller τ = Tx x + tc (surge, sway, yaw; body frame), zero while off.
-        let mut tx = DMatrix::<f64>::zeros(3, N);
+        let mut tx = DMatrix::<f64>::zeros(3, n);
         let mut tc = Vector3::zeros();
         if on {
             let kp = Matrix3::from_diagonal(&self.kp);
@@ -437,12 +465,12 @@ impl Observer {
         let k4 = rt * Matrix3::from_diagonal(&self.k4);
         let mut nx = tx.clone();
         let mut nv = DMatrix::<f64>::zeros(3, 3);
-        let mut nc = tc + k4 * Vector3::new(0.0, 0.0, psi_u);
+        let mut nc = tc + k4 * yc;
         for i in 0..3 {
             nx[(i, NU + i)] -= self.damping[i];
             for j in 0..3 {
                 nx[(i, BIAS + j)] += rt[(i, j)];
-                for l in 0..N {
+                for l in 0..n {
                     nx[(i, l)] += k4[(i, j)] * yx[(j, l)];
                 }
                 for l in 0..3 {
@@ -455,7 +483,7 @@ impl Observer {
         let nv = &minv * nv;
         nc = self.minv * nc;
         for i in 0..3 {
-            for j in 0..N {
+            for j in 0..n {
                 axx[(NU + i, j)] += nx[(i, j)];
             }
             for j in 0..3 {
@@ -464,31 +492,34 @@ impl Observer {
             axc[NU + i] += nc[i];
         }
         // The force on the hull: (X, Y, 0) and (0, 0, N), body frame.
-        let mut fx = DMatrix::zeros(6, N);
+        let mut fx = DMatrix::zeros(6, n);
         let mut fc = DVector::zeros(6);
         for (k, row) in [0usize, 1, 5].into_iter().enumerate() {
-            for j in 0..N {
+            for j in 0..n {
                 fx[(row, j)] = tx[(k, j)];
             }
             fc[row] = tc[k];
         }
         OwnLinear {
             axx,
-            axnu: DMatrix::zeros(N, 6),
+            axnu: DMatrix::zeros(n, 6),
             axv,
             axc,
             fx,
             fnu: DMatrix::zeros(6, 6),
             fc,
             account: 0,
-            diss: DMatrix::zeros(N + 6, N + 6),
+            diss: DMatrix::zeros(n + 6, n + 6),
             port: true,
         }
     }
 
     /// The rows at the frozen view, with the measured position's offset `x_o` in the constant.
     pub fn rows_at(&self, fr: &Frozen) -> OwnLinear {
-        let mut l = self.rows(fr.euler.z, fr.control_on);
+        if let (Some(_), Some(h)) = (&self.sensors, &fr.held) {
+            return self.rows(h[2], fr.control_on, Some(h));
+        }
+        let mut l = self.rows(fr.euler.z, fr.control_on, None);
         // y = v + x_o: the constant gets the rows on v times x_o.
         let xo = DVector::from_column_slice(fr.origin.as_slice());
         l.axc += &l.axv * xo;
@@ -506,6 +537,21 @@ impl Observer {
             x[ETA + i] = eta[i];
             x[BIAS + i] = self.initial_bias[i];
         }
+        if let Some(sn) = &self.sensors {
+            sn.init(x_pos, psi, &mut x[N..]);
+        }
+    }
+
+    /// The sensors' samples at the end of a step at time `t` (and where a run starts).
+    pub fn end_step(&self, t: f64, pos: &Vector3<f64>, psi: f64, x: &mut [f64]) {
+        if let Some(sn) = &self.sensors {
+            sn.update(t, pos, psi, &mut x[N..]);
+        }
+    }
+
+    /// Where the sensors' held measurements are in the own states.
+    pub fn held_states(&self) -> Option<std::ops::Range<usize>> {
+        self.sensors.as_ref().map(|_| N..N + HELD)
     }
 
     /// How far the estimates are from the vessel: the horizontal position and the heading.

@@ -71,3 +71,28 @@ impl OwnLinear {
         }
     }
 }
+
+/// A named scalar a component reports at a state, for the results (CF units).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Output {
+    pub name: String,
+    pub unit: &'static str,
+    pub long_name: String,
+    pub value: f64,
+}
+
+impl Output {
+    pub fn new(
+        name: impl Into<String>,
+        unit: &'static str,
+        long_name: impl Into<String>,
+        value: f64,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            unit,
+            long_name: long_name.into(),
+            value,
+        }
+    }
+}

@@ -112,6 +112,11 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
                 "an [observer] table needs control.feedback = \"observer\" (the observer's estimates act through the controller); set it, or remove [observer] for the controller on the vessel's state".into(),
             ))
         }
+        _ if p.has("sensors") => {
+            return Err(Error::InvalidInput(
+                "a [sensors] table needs control.feedback = \"observer\" with an [observer] table: the observer reads the sensors (the controller on the vessel's state reads no sensor); set them, or remove [sensors]".into(),
+            ))
+        }
         _ => None,
     };
     Ok(Some(Arc::new(Pid {
@@ -511,6 +516,14 @@ impl Force for Pid {
             o.init(&s.x, crate::lie::so3::euler_and_w(&s.q).0.z, x);
         }
         Ok(())
+    }
+    fn own_end_step(&self, t: f64, s: &VesselState, x: &mut [f64]) {
+        if let Some(o) = &self.observer {
+            o.end_step(t, &s.x, crate::lie::so3::euler_and_w(&s.q).0.z, x);
+        }
+    }
+    fn held_states(&self) -> Option<std::ops::Range<usize>> {
+        self.observer.as_ref().and_then(|o| o.held_states())
     }
     fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], out: &mut Vec<Output>) {
         if let Some(o) = &self.observer {

@@ -135,6 +135,7 @@ impl<'a> VesselSystem<'a> {
                 }
                 e.fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
                 e.fr.actuators = s.act;
+                e.fr.held = self.held_of(s);
                 e
             }
             Some(e) => {

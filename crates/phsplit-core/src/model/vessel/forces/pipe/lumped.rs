@@ -320,7 +320,7 @@ impl Force for LumpedPipe {
         let pull = self.chain.rates(x, &top, rates);
         self.wrench(fr, &pull)
     }
-    fn own_end_step(&self, s: &VesselState, x: &mut [f64]) {
+    fn own_end_step(&self, _t: f64, s: &VesselState, x: &mut [f64]) {
         let k = self.chain.dim();
         let c = (s.x + s.q * self.hang_off - self.chain.node(x, 0)) / DRIFT_RELAXATION;
         x[k..k + 3].copy_from_slice(c.as_slice());

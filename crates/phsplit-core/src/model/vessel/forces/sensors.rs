@@ -1,0 +1,309 @@
+//! The position and heading sensors the observer reads (docs/model.md §5.20, `[sensors]`): a
+//! GNSS receiver's horizontal position and a gyrocompass's heading, each sampled at its rate,
+//! with a constant bias and white noise from a seed, and held between samples (zero-order
+//! hold), as a DP system's sensors deliver them (Fossen 2021, §13.1; Sørensen, *A survey of
+//! dynamic positioning control systems*, Annu. Rev. Control 35 (2011) 123–136, §3).
+//!
+//! Keys: `gnss_rate`, `gyro_rate` (Hz, required: a sensor has no default rate), `gnss_noise`
+//! (m, standard deviation of each horizontal axis; default 0), `gnss_bias` (2 numbers, m,
+//! spatial x and y; default 0), `gyro_noise` (rad, standard deviation; default 0), `gyro_bias`
+//! (rad; default 0), `gnss_dropout`, `gyro_dropout` (rows `[start, end]`, s: the sensor delivers
+//! nothing from `start` to `end`), `seed` (integer ≥ 0; default 0).
+//!
+//! Sampling: at the end of every step at time `t` the sensor takes a sample if a sample
+//! instant `k / rate` has passed since its last one, `k = ⌊t · rate⌋`: so the samples are the
+//! state at the step ends, exactly at the instants when the sample period is a whole number of
+//! steps, else at the first step end after each instant. The sample is the true value plus the
+//! bias plus the noise of sample `k`, a normal deviate drawn from `(seed, sensor, k)` alone
+//! (SplitMix64, Steele, Lea & Flood 2014, and the Box–Muller transform), so a run cut into
+//! parts, a rerun and an FMU draw the same numbers.
+//!
+//! Dropout: while a sensor is out its measurement is marked invalid and the observer runs on
+//! its model alone (no injection from that sensor: dead reckoning); when it returns, it samples
+//! at once. The held values are own states of the controller (not energy: they store nothing of
+//! H); what the observer does with them is in `observer.rs`.
+
+use crate::error::Error;
+use crate::model::vessel::params::{Params, Physical, Range};
+use nalgebra::Vector3;
+use toml::Value;
+
+const T: &str = "sensors";
+
+/// Own states of the sensors, after the observer's: the held measurement `(x, y, ψ)`, each
+/// sensor's validity (1 or 0), and the index of each sensor's last sample.
+pub const N: usize = 7;
+const VALID_GNSS: usize = 3;
+const VALID_GYRO: usize = 4;
+const K_GNSS: usize = 5;
+const K_GYRO: usize = 6;
+
+const RATE: Physical = Physical {
+    lo: 0.0,
+    hi: 1000.0,
+    lo_closed: false,
+    hi_closed: true,
+    why: "a position or heading sensor samples at most 1000 times a second",
+};
+const POSITION_NOISE: Physical = Physical {
+    lo: 0.0,
+    hi: 100.0,
+    lo_closed: true,
+    hi_closed: true,
+    why: "a position fix worse than 100 m is no DP sensor's",
+};
+const POSITION_BIAS: Physical = Physical {
+    lo: -1000.0,
+    hi: 1000.0,
+    lo_closed: true,
+    hi_closed: true,
+    why: "a position bias beyond 1 km is no DP sensor's",
+};
+const HEADING_ERROR: Physical = Physical {
+    lo: -0.5,
+    hi: 0.5,
+    lo_closed: true,
+    hi_closed: true,
+    why:
+        "radians; a heading error beyond 0.5 rad (29°) is no gyrocompass's, or an angle in degrees",
+};
+
+#[derive(Debug, Clone, PartialEq)]
+struct Sensor {
+    rate: f64,
+    dropout: Vec<(f64, f64)>,
+}
+
+impl Sensor {
+    fn out_at(&self, t: f64) -> bool {
+        self.dropout.iter().any(|&(a, b)| t >= a && t < b)
+    }
+    /// The index of the last sample instant at or before `t`.
+    fn index(&self, t: f64) -> f64 {
+        (t * self.rate + 1e-9).floor()
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sensors {
+    gnss: Sensor,
+    gyro: Sensor,
+    gnss_noise: f64,
+    gnss_bias: [f64; 2],
+    gyro_noise: f64,
+    gyro_bias: f64,
+    seed: u64,
+}
+
+fn dropout(p: &mut Params, key: &str) -> crate::Result<Vec<(f64, f64)>> {
+    let Some(rows) = p.rows(
+        T,
+        key,
+        2,
+        "s",
+        Range::Physical(&super::super::params::physical::TIME),
+    )?
+    else {
+        return Ok(Vec::new());
+    };
+    let mut last = f64::NEG_INFINITY;
+    let mut out = Vec::with_capacity(rows.len());
+    for (i, r) in rows.iter().enumerate() {
+        if r[1] <= r[0] {
+            return Err(Error::InvalidInput(format!(
+                "sensors.{key}[{i}] = [{}, {}]: a dropout is [start, end] with end > start (s)",
+                r[0], r[1]
+            )));
+        }
+        if r[0] < last {
+            return Err(Error::InvalidInput(format!(
+                "sensors.{key}[{i}] starts at {} s, before the dropout above it ends ({last} s): give the dropouts in time order, without overlaps",
+                r[0]
+            )));
+        }
+        last = r[1];
+        out.push((r[0], r[1]));
+    }
+    Ok(out)
+}
+
+/// Table `[sensors]` (module documentation), or `None` without it.
+pub fn read(p: &mut Params) -> crate::Result<Option<Sensors>> {
+    p.declare(T);
+    if !p.has(T) {
+        return Ok(None);
+    }
+    // Both rates read before either is found missing, so that neither is taken for a
+    // misspelling of the other.
+    let gnss_rate = p.opt_f64(T, "gnss_rate", "Hz", Range::Physical(&RATE))?;
+    let gyro_rate = p.opt_f64(T, "gyro_rate", "Hz", Range::Physical(&RATE))?;
+    let (Some(gnss_rate), Some(gyro_rate)) = (gnss_rate, gyro_rate) else {
+        let key = if gnss_rate.is_none() {
+            "gnss_rate"
+        } else {
+            "gyro_rate"
+        };
+        return Err(p.missing(T, key, "Hz: the sensor's sample rate"));
+    };
+    let gnss_noise = p
+        .opt_f64(T, "gnss_noise", "m", Range::Physical(&POSITION_NOISE))?
+        .unwrap_or(0.0);
+    let gyro_noise = p
+        .opt_f64(T, "gyro_noise", "rad", Range::Physical(&HEADING_ERROR))?
+        .unwrap_or(0.0);
+    if gyro_noise < 0.0 {
+        return Err(Error::InvalidInput(format!(
+            "sensors.gyro_noise must be ≥ 0 (rad, a standard deviation), got {gyro_noise}"
+        )));
+    }
+    let gyro_bias = p
+        .opt_f64(T, "gyro_bias", "rad", Range::Physical(&HEADING_ERROR))?
+        .unwrap_or(0.0);
+    let gnss_bias = match p.rows(T, "gnss_bias", 1, "m", Range::Physical(&POSITION_BIAS))? {
+        None => [0.0; 2],
+        Some(r) if r.len() == 2 => [r[0][0], r[1][0]],
+        Some(r) => {
+            return Err(Error::InvalidInput(format!(
+                "sensors.gnss_bias must be 2 numbers (m, spatial x and y), got {} entries",
+                r.len()
+            )))
+        }
+    };
+    let seed = match p.take_raw(T, "seed")? {
+        None => 0,
+        Some(Value::Integer(i)) if i >= 0 => i as u64,
+        Some(other) => {
+            return Err(Error::InvalidInput(format!(
+                "sensors.seed must be a whole number ≥ 0, got {} {other}",
+                other.type_str()
+            )))
+        }
+    };
+    p.record_value(T, "seed", Value::Integer(seed as i64));
+    let gnss = Sensor {
+        rate: gnss_rate,
+        dropout: dropout(p, "gnss_dropout")?,
+    };
+    let gyro = Sensor {
+        rate: gyro_rate,
+        dropout: dropout(p, "gyro_dropout")?,
+    };
+    Ok(Some(Sensors {
+        gnss,
+        gyro,
+        gnss_noise,
+        gnss_bias,
+        gyro_noise,
+        gyro_bias,
+        seed,
+    }))
+}
+
+/// SplitMix64's output for `x` (Steele, Lea & Flood, OOPSLA 2014).
+fn splitmix(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^ (x >> 31)
+}
+
+/// A standard normal deviate from `(seed, stream, k)` (Box–Muller on two uniforms in (0, 1)).
+fn normal(seed: u64, stream: u64, k: f64) -> f64 {
+    let base =
+        splitmix(seed ^ splitmix(stream.wrapping_mul(0xD6E8_FEB8_6659_FD93) ^ (k as i64 as u64)));
+    let u = |x: u64| ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+    let (u1, u2) = (u(splitmix(base)), u(splitmix(base ^ 0xA5A5_A5A5_A5A5_A5A5)));
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+impl Sensors {
+    /// The own states' names, units and long names.
+    pub fn states() -> [(&'static str, &'static str, &'static str); N] {
+        [
+            (
+                "measured_x",
+                "m",
+                "position x the GNSS receiver last delivered (spatial)",
+            ),
+            (
+                "measured_y",
+                "m",
+                "position y the GNSS receiver last delivered (spatial)",
+            ),
+            (
+                "measured_heading",
+                "rad",
+                "heading the gyrocompass last delivered",
+            ),
+            (
+                "gnss_valid",
+                "1",
+                "1 while the GNSS receiver delivers, 0 during its dropouts",
+            ),
+            (
+                "gyro_valid",
+                "1",
+                "1 while the gyrocompass delivers, 0 during its dropouts",
+            ),
+            (
+                "gnss_sample",
+                "1",
+                "index of the GNSS receiver's last sample (time × rate)",
+            ),
+            (
+                "gyro_sample",
+                "1",
+                "index of the gyrocompass's last sample (time × rate)",
+            ),
+        ]
+    }
+
+    /// Before the run: the true position and heading, marked not yet delivered (validity 0),
+    /// so that the run's start ([`Self::update`] there) takes the first samples.
+    pub fn init(&self, pos: &Vector3<f64>, psi: f64, x: &mut [f64]) {
+        x.fill(0.0);
+        x[0] = pos.x;
+        x[1] = pos.y;
+        x[2] = psi;
+    }
+
+    /// At time `t`, with the vessel at position `pos` and heading `psi`: take the samples due
+    /// and mark the sensors out or in (module documentation).
+    pub fn update(&self, t: f64, pos: &Vector3<f64>, psi: f64, x: &mut [f64]) {
+        let out = self.gnss.out_at(t);
+        let k = self.gnss.index(t);
+        if !out && (k != x[K_GNSS] || x[VALID_GNSS] == 0.0) {
+            x[0] = pos.x + self.gnss_bias[0] + self.gnss_noise * normal(self.seed, 1, k);
+            x[1] = pos.y + self.gnss_bias[1] + self.gnss_noise * normal(self.seed, 2, k);
+            x[K_GNSS] = k;
+        }
+        x[VALID_GNSS] = if out { 0.0 } else { 1.0 };
+        let out = self.gyro.out_at(t);
+        let k = self.gyro.index(t);
+        if !out && (k != x[K_GYRO] || x[VALID_GYRO] == 0.0) {
+            x[2] = psi + self.gyro_bias + self.gyro_noise * normal(self.seed, 3, k);
+            x[K_GYRO] = k;
+        }
+        x[VALID_GYRO] = if out { 0.0 } else { 1.0 };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_deviates_are_standard_normal_and_reproducible() {
+        let n = 200_000;
+        let xs: Vec<f64> = (0..n).map(|k| normal(7, 1, k as f64)).collect();
+        let mean = xs.iter().sum::<f64>() / n as f64;
+        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        assert!(mean.abs() < 0.01, "{mean}");
+        assert!((var - 1.0).abs() < 0.01, "{var}");
+        let fourth = xs.iter().map(|x| x.powi(4)).sum::<f64>() / n as f64;
+        assert!((fourth - 3.0).abs() < 0.06, "{fourth}");
+        assert_eq!(normal(7, 1, 12.0), normal(7, 1, 12.0));
+        assert_ne!(normal(7, 1, 12.0), normal(7, 2, 12.0));
+        assert_ne!(normal(7, 1, 12.0), normal(8, 1, 12.0));
+    }
+}
