@@ -56,7 +56,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "feedback": ("-", '"true_state"', '`"true_state"` (the paper\'s) or `"observer"`: the controller acts on the estimates of `[observer]` (§5.20)'),
     },
     "observer": {
-        "wave_frequency": ("rad/s", REQ, "`ω₀` of the wave model, > 0: the sea's peak frequency (§5.20)"),
+        "wave_frequency": ("rad/s", REQ, "`ω₀` of the wave model, in (0, 10]: the sea's peak frequency (§5.20)"),
         "damping": ("kg/s, kg/s, kg m²/s", REQ, "the observer's model damping in surge, sway, yaw, ≥ 0"),
         "wave_damping": ("-", "0.1", "`λ` of the wave model, > 0"),
         "notch_damping": ("-", "1", "`ζₙ` of the notch, > `λ`"),
@@ -65,8 +65,8 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "bias_bandwidth": ("rad/s", "ω₀/5", "`ω_b` at which `K₃`, `K₄` place the low-frequency error dynamics critically damped"),
         "velocity_gain": ("N/m, N/m, N m/rad", "placed at `ω_b`", "`K₄`, > 0; with `bias_gain`, `1/T < K₃/K₄ < ω₀`"),
         "bias_gain": ("N/(m s), N/(m s), N m/(rad s)", "placed at `ω_b`", "`K₃`, > 0"),
-        "initial_estimate": ("m, m, rad", "the measured", "initial `(x̂, ŷ, ψ̂)`"),
-        "initial_bias": ("N, N, N m", "[0, 0, 0]", "initial bias estimate, spatial frame"),
+        "initial_estimate": ("m, m, rad", "the measured", "initial `(x̂, ŷ, ψ̂)`: within 10 km of the set point, the heading within ±2π"),
+        "initial_bias": ("N, N, N m", "[0, 0, 0]", "initial bias estimate, spatial frame, each within ±1e10"),
     },
     "sensors": {
         "gnss_rate": ("Hz", REQ, "the GNSS position's sample rate, in (0, 1000]; samples held between (§5.20, *Sensors*)"),
@@ -130,7 +130,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "diameter": ("m", REQ, "hydrodynamic outer diameter (over any coating), > 0"),
         "water_depth": ("m", REQ, "seabed below the still water line, in (0, 11000]"),
         "hang_off": ("m", REQ, "where the pipe leaves the vessel, body frame, above the seabed"),
-        "anchor": ("m", REQ, "`[x, y]` of the pipe's far end on the seabed, spatial"),
+        "anchor": ("m", REQ, "`[x, y]` of the pipe's far end on the seabed, spatial, within `length` of the hang-off point where the run starts"),
         "drag_normal": ("-", "1.2", "normal drag coefficient `C_dn` (MoorDyn's default), ≥ 0"),
         "drag_tangential": ("-", "0.008", "tangential drag coefficient `C_dt` on `π d l`, ≥ 0"),
         "added_mass": ("-", "1.0", "added-mass coefficient `C_a`, isotropic, ≥ 0"),
@@ -158,7 +158,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "N": ("-", "zero", "`k×k`, skew-symmetric: the feedthrough's conservative part"),
         "input": ("-", REQ, "the `k` degrees of freedom of the body velocity it takes: `surge`, `sway`, `heave`, `roll`, `pitch`, `yaw`"),
         "point": ("m", "[0, 0, 0]", "body frame: the translational inputs are this point's velocity, and the force acts there"),
-        "initial": ("the states' units", "zeros", "the states where a run starts"),
+        "initial": ("the states' units", "zeros", "the states where a run starts, storing at most 1e12 J (½ xᵀQx)"),
     },
     "setpoint": {
         "natural_frequency": ("rad/s", REQ, "ω of Fossen's third-order reference model, > 0 (§5.7)"),
@@ -184,7 +184,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "weight": ("-", "1", "cost of its thrust in the allocation, > 0"),
         "thrust_rate": ("N/s", "none", "fastest change of thrust, > 0"),
         "turn_rate": ("degrees/s", "none", "azimuth: fastest turn, > 0"),
-        "lost_at": ("s", "none", "the time the thruster is lost: from then it delivers nothing and the allocation redistributes the demand (§5.8)"),
+        "lost_at": ("s", "none", "the time the thruster is lost: from then it delivers nothing and the allocation redistributes the demand (§5.8); within ±1e9 s"),
     },
     "waves": {
         "frequencies": ("rad/s", REQ, "ω_k of the sea state's components, > 0 (realised by `phsplit.sea`; §5.9)"),

@@ -321,7 +321,7 @@ CATALOGUE: list[Bad] = [
     Bad("CLI: option without its value", cli(*SIM, "--method"), C, ("--method", "expected one argument")),
     Bad("CLI: rerun of a file that is not phsplit's", cli("rerun", "x.nc", files={"x.nc": b"CDF\x01junk"}), C,
         ("x.nc", "not a NetCDF file")),
-    Bad("CLI: plot with a negative watch circle", cli("plot", "x.nc", "--watch-circle", "-5"), C, ("--watch-circle", "> 0")),
+    Bad("CLI: plot with a negative watch circle", cli("plot", "x.nc", "--watch-circle", "-5"), C, ("--watch-circle", "(0, 1e6)")),
     Bad("CLI: sweep without [sweep]", cli("sweep", "s.toml", "--out", "st", files={"s.toml": b"[simulation]\nh = 1.0\n"}),
         C, ("[sweep]",)),
 ]
@@ -351,7 +351,12 @@ CATALOGUE += [
         ("win64 binary", "nowhere.dll")),
     Bad("CLI: fmu without a command", cli("fmu"), C, ("'export' or 'load'",)),
     Bad("CLI: load FMU with a zero period", cli("fmu", "load", "-o", "l.fmu", "--period", "0"), C,
-        ("period", "> 0")),
+        ("--period", "[1e-3, 1e7]")),
+    Bad("CLI: load FMU with a period of a picosecond", cli("fmu", "load", "-o", "l.fmu", "--period", "1e-12"), C,
+        ("--period", "[1e-3, 1e7]")),
+    Bad("CLI: load FMU with a force beyond any vessel's", cli("fmu", "load", "-o", "l.fmu", "--force-mean", "1e300", "0", "0"),
+        C, ("--force-mean", "±1e+10")),
+    Bad("CLI: rerun of a capability result", lambda: _rerun_capability(), C, ("DP capability", "nothing to repeat")),
     Bad("load FMU with a 2-vector", lambda: __import__("phsplit.fmu").fmu.export_load("l.fmu", force_mean=[1, 2]), E,
         ("force_mean", "3 finite numbers")),
     Bad("FMU of a missing scenario", cli("fmu", "export", "nowhere.toml", "-o", "v.fmu"), C, ("nowhere.toml",)),
@@ -1348,6 +1353,34 @@ CATALOGUE += [
         ("gnss_nosie", "gnss_noise")),
 ]
 
+
+def _one_line_syntax_error() -> object:
+    try:
+        phsplit.Vessel.from_toml_str("[vessel\nmass = 1\n")
+    except phsplit.ScenarioParseError as e:
+        if "\n" in str(e):
+            raise AssertionError(f"a syntax error over several lines: {e!r}") from None
+        raise
+
+
+CATALOGUE += [
+    # outputs that cannot be written, found before anything runs (an administrator's run passes
+    # the permission checks everywhere: the folder is tried)
+    Bad("CLI: rao into a folder of /proc", cli("rao", "--frequencies", "0.56", "--headings", "90", "--dofs", "roll",
+                                               "--t-end", "240", "--out", "/proc/rao"), C,
+        ("--out", "/proc", "not a writable folder")),
+    Bad("CLI: capability into /sys/kernel", cli("capability", "dp-capability", "--directions", "0", "--failures",
+                                                "none", "--out", "/sys/kernel"), C,
+        ("--out", "/sys/kernel", "not a writable folder")),
+    Bad("CLI: simulate into a folder of /proc", cli("simulate", "--t-end", "1", "--out", "/proc/run"), C,
+        ("/proc/run",)),
+    Bad("vessel file with a syntax error, said on one line", _one_line_syntax_error, P,
+        ("TOML syntax error", "line 1", "column")),
+    Bad("dynamic pipe anchored farther away than its length", _lumped(anchor=[5000.0, 0.0]), E,
+        ("pipe.anchor", "farther than pipe.length", "600")),
+]
+
+
 def _pipelay_lost(*lost: int, value: object = 300.0) -> Callable[[], object]:
     def make():
         from phsplit import scenario as scn
@@ -1398,7 +1431,130 @@ CATALOGUE += [
     Bad("single failures of a vessel without thrusters", _failures(vessel=phsplit.Vessel.paper()), E,
         ("single_failures", "no [thrusters]")),
     Bad("CLI: failures of a scenario without thrusters", cli("failures", "dp-weather", "--at", "5"), C,
-        ("single_failures", "no [thrusters]")),
+        ("vessel", "no [thrusters]")),
     Bad("CLI: failures without the time of the failure", cli("failures", "pipelay"), C,
         ("--at",)),
+]
+
+
+def _pipelay_with_loss(t: float = 100.0) -> bytes:
+    from phsplit import scenario as scn
+
+    with open(os.path.join(scn.SHIPPED_DIR, "pipelay.toml"), encoding="utf-8") as f:
+        text = f.read()
+    marker = "max_thrust = 6.55e5"
+    assert marker in text
+    return text.replace(marker, f"{marker}\nlost_at = {t}").encode()
+
+
+def _rerun_capability() -> object:
+    import tempfile as tf
+
+    from phsplit.capability import capability
+
+    with tf.TemporaryDirectory() as d:
+        p = os.path.join(d, "cap.nc")
+        capability("dp-capability", directions=[0.0], failures="none").to_netcdf(p)
+        with open(p, "rb") as f:
+            data = f.read()
+    return cli("rerun", "cap.nc", files={"cap.nc": data})()
+
+
+def _capability_lost() -> object:
+    from phsplit import scenario as scn
+
+    d = scn.load("dp-capability").vessel.to_dict()
+    d["thrusters"]["unit"][3]["lost_at"] = 100.0
+    return phsplit.Vessel.from_dict(d)
+
+
+def _seakeeping(fn: str, *args, **kw) -> Callable[[], object]:
+    def run():
+        from phsplit import seakeeping
+
+        return getattr(seakeeping, fn)(*args, **kw)
+    return run
+
+
+def _held(*args, **kw) -> Callable[[], object]:
+    def run():
+        from phsplit import scenario as scn
+        from phsplit.capability import held
+
+        return held(scn.load("dp-capability").vessel, *args, **kw)
+    return run
+
+
+def _footprint_of(s_or_name, **kw) -> Callable[[], object]:
+    def run():
+        from phsplit import dp
+
+        s = s_or_name
+        if s == "run":
+            s = phsplit.simulate(phsplit.Vessel.paper(), (0.0, 4.0), 0.5, "sp2")
+        return dp.footprint(s, **kw)
+    return run
+
+
+CATALOGUE += [
+    # values that make no sense on the DP system's tables and functions
+    Bad("observer initial heading estimate in degrees", _observer("initial_estimate = [780.0, 20.0, 30.0]\n"), E,
+        ("observer.initial_estimate[2]", "degrees")),
+    Bad("observer initial estimate far from any set point", _observer("initial_estimate = [1e300, 0.0, 0.0]\n"), E,
+        ("observer.initial_estimate", "10000 m of the set point")),
+    Bad("observer initial bias beyond any environment", _observer("initial_bias = [1e300, 0.0, 0.0]\n"), E,
+        ("observer.initial_bias[0]", "10 GN")),
+    Bad("observer cut-off frequency in other units", _observer("cutoff_frequency = 40.0\n"), E,
+        ("observer.cutoff_frequency", "10", "rad/s")),
+    Bad("thruster lost far in the future", _pipelay_lost(3, value=1e12), E, ("lost_at", "1e9 s")),
+    Bad("CLI: failure study of a scenario that already loses a thruster",
+        lambda: cli("failures", "pl.toml", "--at", "5", "--t-end", "10", files={"pl.toml": _pipelay_with_loss()})(), C,
+        ("thrusters.unit[3].lost_at", "remove lost_at")),
+    Bad("CLI: failure at the very end of the run", cli("failures", "pipelay", "--at", "3599.9"), C,
+        ("--at", "fewer than two saved states")),
+    Bad("capability of a vessel that already loses a thruster",
+        lambda: phsplit.capability(_capability_lost(), directions=[0.0]), E,
+        ("capability: vessel", "lost_at", "failures")),
+    Bad("failure study on no workers", lambda: _failures(max_workers=-1)(), E, ("max_workers", "≥ 1")),
+    Bad("footprint of a file name", _footprint_of("file.nc", reference=(0.0, 0.0, 0.0)), E,
+        ("footprint", "phsplit.Solution", "str")),
+    Bad("footprint about a heading in degrees", _footprint_of("run", reference=(780.0, 20.0, 31.0)), E,
+        ("footprint", "heading", "degrees")),
+    Bad("footprint about a reference given as text", _footprint_of("run", reference="here"), E,
+        ("footprint: reference", "3 finite numbers")),
+    Bad("allocation of a demand of two numbers", _held([1.0, 2.0]), E, ("capability: demand", "3 finite numbers")),
+    Bad("allocation of a demand that is not a number", _held([float("nan"), 0.0, 0.0]), E,
+        ("capability: demand", "3 finite numbers")),
+    Bad("allocation without a fractional thruster", _held([1.0, 0.0, 0.0], lost=[0.5]), E,
+        ("capability: lost", "whole numbers")),
+    Bad("capability with failures of None", lambda: phsplit.capability("dp-capability", failures=None), E,
+        ("capability: failures", "got None")),
+    Bad("frequency-domain RAO from 720 degrees", _seakeeping("frequency_rao", phsplit.Vessel.paper(), 0.56, 720.0), E,
+        ("frequency_rao: heading", "±360")),
+    Bad("frequency-domain RAO at a frequency given as text", _seakeeping("frequency_rao", phsplit.Vessel.paper(), "0.5", 90.0), E,
+        ("frequency_rao: omega", "positive number")),
+    Bad("linear model of a mapping", _seakeeping("linear_model", {}), E, ("linear_model: vessel", "phsplit.Vessel")),
+    Bad("RAO in a wave too steep to exist", _seakeeping("rao", phsplit.Vessel.paper(), [0.56], 90.0, amplitude=1e6,
+                                                         check_only=True), E, ("amplitude", "1/7", "break")),
+    Bad("roll damping with a misspelt key", vessel_with("[initial]", "[roll_damping]\nlinera = 1e8\n\n[initial]"), P,
+        ("linera", "linear")),
+    Bad("port-Hamiltonian subsystem starting with more energy than any vessel has",
+        _ph(initial="[1e150, 0.0]"), E, ("port_hamiltonian.initial", "J", "units of Q")),
+]
+
+
+CATALOGUE += [
+    # a sweep's values, each tried on the vessel before anything starts
+    Bad("sweep over a mass no vessel can have",
+        _load_sweep_text(_SWEEP_HEAD + b'[sweep.parameters]\n"vessel.mass" = [-6e6, 7e6]\n'), E,
+        ("sweep.parameters.vessel.mass = -6e+06", "vessel.mass must be > 0")),
+    Bad("sweep that lists a value twice",
+        _load_sweep_text(_SWEEP_HEAD + b'[sweep.parameters]\n"vessel.mass" = [6e6, 6e6]\n'), E,
+        ("sweep.parameters.vessel.mass", "twice")),
+    Bad("sweep over a setting that is not a number",
+        _load_sweep_text(_SWEEP_HEAD + b'[sweep.parameters]\n"control.feedback" = [0.0, 1.0]\n'), E,
+        ("control.feedback", "not a number")),
+    Bad("random sweep whose lower bound no vessel can have",
+        _load_sweep_text(_SWEEP_HEAD + b'mode = "random"\nsamples = 2\n[sweep.parameters]\n"vessel.mass" = {low = -1.0, high = 7e6}\n'),
+        E, ("sweep.parameters.vessel.mass = -1", "> 0")),
 ]

@@ -54,7 +54,7 @@ mode = "grid"
 
 [sweep.parameters]
 "control.kp_translational[0]" = [2e5, 4e5, 8e5]
-"vessel.mass" = [-1.0, 6e6, 7e6]
+"vessel.mass" = [5e6, 6e6, 7e6]
 """
 
 
@@ -68,7 +68,7 @@ def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
     assert done_cases(str(store)) == ids
     with phsplit.open_dataset(store / "summary.nc") as s:
         status = list(s["status"].values)
-    assert status.count("invalid") == 3 and status.count("completed") == 6
+    assert status.count("completed") == 9
     # the summary written from the results in memory is the one the case files give back
     written = (store / "summary.csv").read_text()
     from phsplit.batch import write_summary
@@ -79,13 +79,13 @@ def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
         assert one["position"].chunking() == list(one["position"].shape)
     # the computed cases as one lazy dataset with a case dimension
     with phsplit.open_sweep(store) as all_cases:
-        assert all_cases.sizes["case"] == 6 and all_cases["position"].chunks is not None
-        ran = [sw.case_id(i) for i in range(9) if sw.cases[i]["vessel.mass"] > 0]
+        assert all_cases.sizes["case"] == 9 and all_cases["position"].chunks is not None
+        ran = [sw.case_id(i) for i in range(9)]
         assert list(all_cases["case_id"].values) == ran
         i = 4  # the case's own file holds the same numbers
         with phsplit.open_dataset(store / "cases" / f"{ran[i]}.nc") as one:
             np.testing.assert_array_equal(all_cases["position"].isel(case=i).values, one["position"].values)
-        np.testing.assert_array_equal(all_cases["vessel_mass"].values, [6e6, 7e6] * 3)
+        np.testing.assert_array_equal(all_cases["vessel_mass"].values, [5e6, 6e6, 7e6] * 3)
     # a second run reuses everything
     t0 = time.monotonic()
     res = run_sweep(sw, str(store), n_workers=2, progress=False)
@@ -96,11 +96,24 @@ def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
     assert res["computed"] == 1 and done_cases(str(store)) == ids
 
 
+def test_a_sweep_file_with_a_value_the_vessel_refuses_starts_nothing(tmp_path, capsys):
+    """Each value of a sweep file is tried on the vessel before anything is written or started
+    (a case refused only by its combination of values is stored as invalid, as simulate_many
+    does)."""
+    f = tmp_path / "grid.toml"
+    f.write_text(SWEEP_TOML.format(t_end=50.0, h=0.5).replace("[5e6, 6e6, 7e6]", "[-1.0, 6e6, 7e6]"))
+    store = tmp_path / "grid.store"
+    assert main(["sweep", str(f), "--out", str(store), "--workers", "2", "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "sweep.parameters.vessel.mass = -1" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["grid.toml"]
+
+
 def test_a_worker_killed_mid_sweep_loses_no_case(tmp_path):
     from dask.distributed import Client, LocalCluster
 
     f = tmp_path / "grid.toml"
-    f.write_text(SWEEP_TOML.format(t_end=600.0, h=0.05).replace('[-1.0, 6e6, 7e6]', '[5e6, 6e6, 7e6, 8e6]'))
+    f.write_text(SWEEP_TOML.format(t_end=600.0, h=0.05).replace('[5e6, 6e6, 7e6]', '[5e6, 6e6, 7e6, 8e6]'))
     sw = load_sweep(str(f))
     store = tmp_path / "store"
     cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
@@ -163,7 +176,7 @@ def test_every_setting_vessel_and_version_enters_the_case_id(monkeypatch):
 def test_a_sweep_rerun_with_other_settings_recomputes_every_case(tmp_path):
     """A store reused with other settings: sp2 on [0, 100], then rk4 on [0, 20] in the same store."""
     f = tmp_path / "gains.toml"
-    f.write_text(SWEEP_TOML.format(t_end=100.0, h=0.5).replace("[-1.0, 6e6, 7e6]", "[6e6]"))
+    f.write_text(SWEEP_TOML.format(t_end=100.0, h=0.5).replace("[5e6, 6e6, 7e6]", "[6e6]"))
     store = tmp_path / "gains.store"
     assert main(["sweep", str(f), "--out", str(store), "--workers", "1", "--no-progress"]) == 0
     f.write_text(f.read_text().replace('"sp2"', '"rk4"').replace("[0.0, 100.0]", "[0.0, 20.0]"))
@@ -216,7 +229,7 @@ def test_a_task_lost_outside_its_case_is_reported_not_stored(tmp_path, monkeypat
     import phsplit.batch as batch
 
     f = tmp_path / "grid.toml"
-    f.write_text(SWEEP_TOML.format(t_end=20.0, h=0.5).replace("[-1.0, 6e6, 7e6]", "[6e6]"))
+    f.write_text(SWEEP_TOML.format(t_end=20.0, h=0.5).replace("[5e6, 6e6, 7e6]", "[6e6]"))
     sw = load_sweep(str(f))
     store = tmp_path / "store"
     real = batch._run_case

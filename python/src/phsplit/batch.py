@@ -337,6 +337,22 @@ def load_sweep(path: str) -> Sweep:
         if len(values) > MAX_CASES:
             raise _core.InvalidInputError(f"{path}: sweep.parameters.{k} lists {len(values)} values; at most "
                                           f"{MAX_CASES}")
+        if isinstance(spec, list) and len(set(map(float, values))) != len(values):
+            twice = next(v for i, v in enumerate(values) if float(v) in map(float, values[:i]))
+            raise _core.InvalidInputError(f"{path}: sweep.parameters.{k} lists {twice!r} twice: each case once")
+        cur = d0
+        for seg in _resolve(d0, k):
+            cur = cur[seg] if isinstance(cur, list) or seg in cur else 0.0
+        if isinstance(cur, (bool, str)) or not isinstance(cur, (int, float)):
+            raise _core.InvalidInputError(f"{path}: sweep.parameters.{k}: {k} is {cur!r}, not a number; only "
+                                          "numbers can be swept")
+        # each value on its own, with the rest of the vessel as it is: a value the vessel refuses
+        # is refused here, before anything is written or started
+        for v in sorted(set(map(float, values))):
+            try:
+                with_parameters(sc.vessel, {k: v})
+            except (_core.InvalidInputError, _core.ScenarioParseError) as e:
+                raise _core.InvalidInputError(f"{path}: sweep.parameters.{k} = {v:g}: {e}") from None
     if mode == "grid":
         n_grid = math.prod(len(params[k]) if isinstance(params[k], list) else 1 for k in keys)
         if n_grid > MAX_CASES:

@@ -142,6 +142,10 @@ class _Loads:
         if "thrusters" not in tables:
             _bad("vessel", "has no [thrusters] table: the capability is that of its thrusters "
                  "(e.g. the shipped scenario dp-capability)")
+        lost = [i for i, u in enumerate(tables["thrusters"].get("unit", [])) if "lost_at" in u]
+        if lost:
+            _bad("vessel", f"thrusters.unit[{lost[0]}].lost_at is set: the capability takes its failure cases from "
+                 "`failures` (each thruster lost in turn by default); remove lost_at")
         self.heading = float(tables["initial"]["euler"][2])
         base = copy.deepcopy(tables)
         for k in ("waves", "thrusters", "current"):
@@ -265,7 +269,10 @@ class _Loads:
 
 
 def _cases(failures: Any, n: int) -> list[tuple[str, list[int]]]:
-    if failures is None or (isinstance(failures, str) and failures == "none"):
+    if failures is None:
+        _bad("failures", "must be 'single' (each thruster lost in turn), 'none', or a list of lists of thruster "
+             "indices, got None")
+    if isinstance(failures, str) and failures == "none":
         return [("intact", [])]
     if isinstance(failures, str):
         if failures != "single":
@@ -306,7 +313,8 @@ def _directions(directions: Any) -> np.ndarray:
     if d.ndim != 1 or d.size == 0 or not np.all(np.isfinite(d)):
         _bad("directions", f"must be a non-empty list of finite numbers (degrees), got {directions!r}")
     if np.any((d < 0) | (d >= 360)):
-        _bad("directions", "must lie in [0, 360) degrees (where the environment comes from, off the bow, clockwise)")
+        _bad("directions", f"must lie in [0, 360) degrees (where the environment comes from, off the bow, clockwise), "
+             f"got {[float(x) for x in d[(d < 0) | (d >= 360)]][0]:g}")
     if len(np.unique(d)) != len(d):
         _bad("directions", "must not repeat a direction")
     return d
@@ -315,7 +323,19 @@ def _directions(directions: Any) -> np.ndarray:
 def held(vessel: Vessel, demand: Sequence[float], lost: Sequence[int] = ()) -> dict:
     """The core's allocation of a demand (X, Y, N) on the vessel's thrusters without ``lost``:
     ``scale`` (1 when held), ``utilisation``, ``thrust``, ``angle``."""
-    return _core.allocate(vessel._inner, [float(x) for x in demand], [int(i) for i in lost])
+    if not isinstance(vessel, Vessel):
+        _bad("vessel", f"must be a phsplit.Vessel, got {type(vessel).__name__}")
+    try:
+        dem = [float(x) for x in demand if not isinstance(x, (bool, str, bytes))]
+        ok = len(dem) == len(list(demand)) == 3 and all(math.isfinite(x) for x in dem)
+    except (TypeError, ValueError):
+        ok = False
+    if isinstance(demand, (str, bytes)) or not ok:
+        _bad("demand", f"must be 3 finite numbers (X N, Y N, N N m), got {demand!r}")
+    if isinstance(lost, (str, bytes)) or not all(isinstance(i, (int, np.integer)) and not isinstance(i, bool)
+                                                  for i in lost):
+        _bad("lost", f"must be a list of thruster indices (whole numbers), got {lost!r}")
+    return _core.allocate(vessel._inner, dem, [int(i) for i in lost])
 
 
 def _feasible(vessel: Vessel, load: np.ndarray, lost: list[int]) -> bool:

@@ -18,12 +18,25 @@ def _check_out_folder(out: str) -> None:
 
 
 def _writable_ancestor(path: str) -> tuple[str, bool]:
-    """The nearest existing folder of ``path`` (itself if it exists) and whether a file or
-    folder can be made in it: what an output that is not yet there needs."""
+    """The nearest existing folder of ``path`` (itself if it exists) and whether a file and a
+    folder can be made in it: what an output that is not yet there needs. Tried, not asked of
+    the permissions (which an administrator's run passes everywhere, /proc and /sys included);
+    what the try makes is removed at once."""
     parent = path
     while not os.path.exists(parent):
         parent = os.path.dirname(os.path.abspath(parent))
-    return parent, os.path.isdir(parent) and os.access(parent, os.W_OK | os.X_OK)
+    if not os.path.isdir(parent):
+        return parent, False
+    try:
+        fd, probe = tempfile.mkstemp(dir=parent, prefix=".phsplit-probe-")
+        os.close(fd)
+        os.remove(probe)
+        if not os.path.exists(path):
+            made = tempfile.mkdtemp(dir=parent, prefix=".phsplit-probe-")
+            os.rmdir(made)
+    except OSError:
+        return parent, False
+    return parent, True
 
 
 def _shipped() -> list[str]:
@@ -384,7 +397,7 @@ def _simulate(args) -> int:
         os.makedirs(out, exist_ok=True)
     except OSError as e:
         raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
-    if not os.access(out, os.W_OK):
+    if not _writable_ancestor(out)[1]:
         raise UsageError(f"output folder {out!r} is not writable")
     name = sc.name + _override_suffix(args)
     nc = os.path.join(out, f"{name}.nc")
@@ -586,7 +599,7 @@ def _reproduce(args) -> int:
         os.makedirs(out, exist_ok=True)
     except OSError as e:
         raise UsageError(f"cannot create output folder {out!r}: {e.strerror}") from None
-    if not os.access(out, os.W_OK | os.X_OK):
+    if not _writable_ancestor(out)[1]:
         raise UsageError(f"output folder {out!r} is not writable")
     t0 = time.perf_counter()
     try:
@@ -655,6 +668,10 @@ def _rerun(args) -> int:
         if not ok:
             raise UsageError(f"cannot create --out {args.out!r}: {parent!r} is not a writable folder")
     ds = open_dataset(args.file)
+    if "wind_speed_limit" in ds:
+        ds.close()
+        raise UsageError(f"{args.file!r} is a DP capability (phsplit capability), not a run: there is nothing "
+                         "to repeat; compute it again with phsplit capability")
     if "case" in ds.dims:
         ds.close()
         raise UsageError(f"{args.file!r} holds cases of a sweep (a batch file of a sweep store), not one run; "
@@ -706,7 +723,7 @@ def _plot(args) -> int:
     from .results import open_dataset
 
     if args.watch_circle is not None and not (args.watch_circle > 0 and args.watch_circle < 1e6):
-        raise UsageError(f"--watch-circle must be a radius in m, > 0, got {args.watch_circle}")
+        raise UsageError(f"--watch-circle must be a radius in m, in (0, 1e6), got {args.watch_circle}")
     out = args.out or os.path.splitext(args.file)[0] + ".png"
     if os.path.splitext(out)[1].lower() not in (".png", ".pdf", ".svg"):
         raise UsageError(f"--out must end in .png, .pdf or .svg, got {out!r}")
@@ -717,7 +734,7 @@ def _plot(args) -> int:
         raise UsageError(f"--out {out!r} is a folder; name the image to write (.png, .pdf or .svg)")
     if os.path.exists(out) and os.path.exists(args.file) and os.path.samefile(out, args.file):
         raise UsageError(f"--out {out!r} would overwrite the result file itself")
-    if not os.access(d, os.W_OK | os.X_OK):
+    if not _writable_ancestor(d)[1]:
         raise UsageError(f"the folder of --out is not writable: {d!r}")
     with open_dataset(args.file) as ds:
         if "position" not in ds or "euler" not in ds:
@@ -751,6 +768,13 @@ def _fmu(args) -> int:
             out = fmu.export_load(args.out, force_mean=args.force_mean, force_amplitude=args.force_amplitude,
                                   moment_mean=args.moment_mean, moment_amplitude=args.moment_amplitude,
                                   period=args.period)
+    except phsplit.InvalidInputError as e:
+        msg = str(e)
+        if args.fmu_command != "export":  # said as the options it came from
+            for k in ("force_mean", "force_amplitude", "moment_mean", "moment_amplitude", "period"):
+                if msg.startswith(k):
+                    raise UsageError("--" + k.replace("_", "-") + msg[len(k):]) from None
+        raise
     except phsplit.PhsplitError as e:
         if isinstance(e, (phsplit.InvalidInputError, phsplit.ScenarioParseError)):
             raise
@@ -765,6 +789,8 @@ def _fmu(args) -> int:
 def _failures(args) -> int:
     import dataclasses
 
+    import phsplit
+
     from . import scenario as scn
     from .dp import check_failure_study, single_failures
 
@@ -774,7 +800,11 @@ def _failures(args) -> int:
         if not (math.isfinite(args.t_end) and args.t_end > st.t_span[0]):
             raise UsageError(f"--t-end must be a finite time after the start ({st.t_span[0]:g} s), got {args.t_end:g}")
         st = dataclasses.replace(st, t_span=(st.t_span[0], args.t_end))
-    n = len(check_failure_study(sc.vessel, st, args.at))
+    try:
+        n = len(check_failure_study(sc.vessel, st, args.at))
+    except phsplit.InvalidInputError as e:
+        raise UsageError(str(e).replace("single_failures: at = ", "--at ").replace("single_failures: at ", "--at ")
+                         .replace("single_failures: ", "")) from None
     print(f"{sc.name}: {n + 1} runs on [{st.t_span[0]:g}, {st.t_span[1]:g}] s, each thruster lost in turn at "
           f"t = {args.at:g} s", flush=True)
     study = single_failures(sc.vessel, st, at=args.at)

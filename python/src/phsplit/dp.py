@@ -42,9 +42,21 @@ def _reference(s, vessel: Vessel | None, reference: Sequence[float] | None) -> t
         if c is None:
             raise _core.InvalidInputError("footprint: the vessel has no [control] table: give reference = (x, y, heading)")
         reference = (c["position_reference"][0], c["position_reference"][1], c["euler_reference"][2])
-    r = [float(v) for v in reference]
-    if len(r) != 3 or not all(math.isfinite(v) for v in r):
-        raise _core.InvalidInputError(f"footprint: reference must be 3 finite numbers (x m, y m, heading rad), got {reference!r}")
+    bad = _core.InvalidInputError(f"footprint: reference must be 3 finite numbers (x m, y m, heading rad), "
+                                  f"got {reference!r}")
+    if isinstance(reference, (str, bytes, dict)):
+        raise bad
+    try:
+        r = [float(v) for v in reference if not isinstance(v, (bool, np.bool_, str, bytes))]
+    except (TypeError, ValueError):
+        raise bad from None
+    if len(r) != 3 or len(r) != len(list(reference)) or not all(math.isfinite(v) for v in r):
+        raise bad
+    if abs(r[2]) > 2 * math.pi:
+        raise _core.InvalidInputError(f"footprint: reference heading must lie within ±2π rad (a larger value is "
+                                      f"a heading in degrees), got {r[2]!r}")
+    if max(abs(r[0]), abs(r[1])) > 1e9:
+        raise _core.InvalidInputError(f"footprint: reference position must lie within 1e9 m of the origin, got {reference!r}")
     return np.tile(r[:2], (n, 1)), np.full(n, r[2])
 
 
@@ -56,6 +68,13 @@ def footprint(s, vessel: Vessel | None = None, reference: Sequence[float] | None
     degrees, the short way round) and, with thrusters, their utilisation (the largest
     |thrust| over its limit: ``utilisation_mean``, ``utilisation_p95``, ``utilisation_max``) and
     the time they spent saturated (``time_saturated``, s, and ``fraction_saturated``)."""
+    from .solution import Solution
+
+    if not isinstance(s, Solution):
+        raise _core.InvalidInputError(f"footprint: the run must be a phsplit.Solution (what phsplit.simulate "
+                                      f"returns), got {type(s).__name__}")
+    if vessel is not None and not isinstance(vessel, Vessel):
+        raise _core.InvalidInputError(f"footprint: vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
     if isinstance(after, bool) or not isinstance(after, (int, float)) or not math.isfinite(after):
         raise _core.InvalidInputError(f"footprint: after must be a finite time in s, got {after!r}")
     keep = np.asarray(s.t) >= after
@@ -126,16 +145,32 @@ def check_failure_study(vessel: Vessel, settings: Settings, at: float) -> list:
     t0, t1 = settings.t_span
     if isinstance(at, bool) or not isinstance(at, (int, float)) or not (t0 <= at < t1):
         raise _core.InvalidInputError(f"single_failures: at must be a time within the run's t_span [{t0:g}, {t1:g}) s, got {at!r}")
+    already = [i for i, u in enumerate(units) if "lost_at" in u]
+    if already:
+        raise _core.InvalidInputError(
+            f"single_failures: thrusters.unit[{already[0]}].lost_at = {units[already[0]]['lost_at']:g} s is set; "
+            "the study loses each thruster in turn at its own time (at): remove lost_at from the vessel")
+    # the footprint after the failure needs two saved states from `at` on
+    h, every = settings.h, settings.save_every
+    n_after = math.floor((t1 - at) / (h * every) + 1e-9)
+    if n_after < 1:
+        raise _core.InvalidInputError(
+            f"single_failures: at = {at:g} s leaves fewer than two saved states before the run ends at {t1:g} s "
+            f"(a state saved every {h * every:g} s): take an earlier time")
 
     return units
 
 
 def single_failures(vessel: Vessel, settings: Settings, at: float, max_workers: int | None = None) -> FailureStudy:
     """Run ``vessel`` with ``settings`` intact and with each of its thrusters lost at ``at`` (s) in
-    turn (``thrusters.unit[i].lost_at``, any it already has kept), on a thread pool, and take
+    turn (``thrusters.unit[i].lost_at``; a vessel that already loses one is refused), on a thread pool, and take
     each case's :func:`footprint` from ``at`` on. A case the allocation cannot take (the thrusters
     left cannot produce surge, sway and yaw) or whose run fails is listed with its error."""
     units = check_failure_study(vessel, settings, at)
+    if max_workers is not None and (isinstance(max_workers, bool) or not isinstance(max_workers, (int, np.integer))
+                                    or max_workers < 1):
+        raise _core.InvalidInputError(f"single_failures: max_workers must be a whole number ≥ 1 (or None: one per "
+                                      f"core), got {max_workers!r}")
 
     def one(lost):
         case = "intact" if lost is None else f"thruster {lost} lost"

@@ -331,7 +331,15 @@ def _vec3(name: str, v: Sequence[float]) -> list[float]:
         raise _core.InvalidInputError(f"{name} must be 3 numbers, got {v!r}") from None
     if len(out) != 3 or not all(x == x and abs(x) != float("inf") for x in out):
         raise _core.InvalidInputError(f"{name} must be 3 finite numbers, got {v!r}")
+    limit = LOAD_LIMIT[name.split("_")[0]]
+    if max(abs(x) for x in out) > limit:
+        raise _core.InvalidInputError(f"{name} must lie within ±{limit:g} ({'N' if name.startswith('force') else 'N m'}; "
+                                      f"no environment or actuator loads a vessel with more), got {v!r}")
     return out
+
+
+#: The largest load the periodic source gives (10 GN, 10 TN m: beyond any vessel's loads).
+LOAD_LIMIT = {"force": 1e10, "moment": 1e13}
 
 
 def export_load(out: str | os.PathLike[str] = "load.fmu", *, force_mean: Sequence[float] = (0, 0, 0),
@@ -351,8 +359,9 @@ def export_load(out: str | os.PathLike[str] = "load.fmu", *, force_mean: Sequenc
         p = float(period)
     except (TypeError, ValueError):
         raise _core.InvalidInputError(f"period must be a number of seconds, got {period!r}") from None
-    if not (p > 0 and p != float("inf")):
-        raise _core.InvalidInputError(f"period must be finite and > 0 (s), got {period!r}")
+    if not (1e-3 <= p <= 1e7):
+        raise _core.InvalidInputError(f"period must be a time in [1e-3, 1e7] s (a load varying faster than a "
+                                      f"millisecond is no vessel's), got {period!r}")
     load["period"] = p
     resources = {"fmu.toml": "[fmu]\nkind = \"load\"\n\n" + _toml({"load": load})}
     return _write_fmu(out, "phsplit periodic load", "a periodic force and moment: mean + amplitude sin(2 pi t / period)",

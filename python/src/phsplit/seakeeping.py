@@ -40,6 +40,13 @@ def _err(msg: str) -> _core.InvalidInputError:
     return _core.InvalidInputError(msg)
 
 
+def _vessel(vessel, what: str) -> None:
+    from .vessel import Vessel
+
+    if not isinstance(vessel, Vessel):
+        raise _err(f"{what}: vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
+
+
 def _skew(r) -> np.ndarray:
     return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
 
@@ -53,6 +60,7 @@ def linear_model(vessel):
     of flotation ``(x_F, y_F)`` (docs/model.md §2.3, §5.15: ``G33 = c``, ``G34 = y_F c``,
     ``G35 = −x_F c``, ``G44 = W GM_T + y_F² c``, ``G45 = −x_F y_F c``, ``G55 = W GM_L + x_F² c``,
     ``c = ρ g A_wp``)."""
+    _vessel(vessel, "linear_model")
     d = vessel.to_dict()
     p = d["vessel"]
     m = p["mass"]
@@ -88,6 +96,7 @@ def roll_damping(vessel) -> tuple[float, float]:
     """``(B₁, B₂)`` of the vessel's ``[roll_damping]`` (N m s, N m s²; zeros without one), ``B₁``
     from ``critical_fraction`` as the core computes it: ``2ζ√(M₄₄ C₄₄)``, ``M₄₄`` the roll entry
     of the mass matrix with the vessel's own added mass."""
+    _vessel(vessel, "roll_damping")
     d = vessel.to_dict()
     t = d.get("roll_damping")
     if not t:
@@ -111,6 +120,7 @@ def roll_damping(vessel) -> tuple[float, float]:
 def waves_table(vessel, dataset=DEFAULT_DATASET) -> dict:
     """The ``[waves]`` transfer functions of the dataset about the vessel's origin (first order
     only: no drift)."""
+    _vessel(vessel, "waves_table")
     out = hydro.from_capytaine(dataset, symmetric=True, vessel=vessel)
     return {k: out["waves"][k] for k in ("rao_frequencies", "rao_directions", "force_rao_real", "force_rao_imag")}
 
@@ -125,6 +135,11 @@ def frequency_rao(vessel, omega: float, heading: float, dataset=DEFAULT_DATASET,
     ``amplitude`` (m, then required): it enters as its harmonic equivalent linear damping
     ``(8/3π) ω φ_a B₂`` (the energy per cycle of ``B₂|φ'|φ'`` in ``φ = φ_a cos ωt``; ITTC
     7.5-02-07-04.5, Himeno 1981), with the roll amplitude ``φ_a`` found by fixed-point iteration."""
+    _vessel(vessel, "frequency_rao")
+    if not (_real(omega) and math.isfinite(float(omega)) and float(omega) > 0):
+        raise _err(f"frequency_rao: omega must be a positive number (rad/s), got {omega!r}")
+    if not (_real(heading) and math.isfinite(float(heading)) and -360.0 <= float(heading) <= 360.0):
+        raise _err(f"frequency_rao: heading must be a number of degrees within ±360, got {heading!r}")
     w, K, Ainf, _, out = data if data is not None else radiation.retardation_data(dataset, vessel=vessel)
     if not w[0] - 1e-9 <= omega <= w[-1] + 1e-9:
         raise _err(f"frequencies: {omega:g} rad/s is outside the dataset's {w[0]:g}-{w[-1]:g} rad/s")
@@ -180,6 +195,9 @@ def time_rao(vessel, waves, omega: float, heading: float, *, amplitude: float = 
     the last ``periods`` periods of ``t_end``, and the solution. ``waves``: :func:`waves_table`."""
     from .simulate import SettingWarning, Vessel, simulate
 
+    _vessel(vessel, "time_rao")
+    if not isinstance(waves, dict):
+        raise _err(f"time_rao: waves must be the transfer functions of waves_table (a dict), got {type(waves).__name__}")
     d = vessel.to_dict()
     d["waves"] = {**waves, **sea.regular(amplitude, omega, direction=heading)}
     v = Vessel.from_dict(d, f"{vessel.source} in a regular wave")
@@ -291,6 +309,13 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
     periods = _positive("periods", periods)
     if periods < 1.0:
         raise _err(f"periods must be at least 1 (the fit window, in periods of the lowest frequency), got {periods:g}")
+    # a regular wave steeper than 1/7 (height over length, deep water) breaks (Michell 1893;
+    # DNV-RP-C205 §3.2.2): a larger amplitude is no wave linear theory describes
+    steep = 2 * amplitude * float(freqs.max()) ** 2 / (2 * math.pi * 9.81)
+    if steep > 1 / 7:
+        raise _err(f"amplitude = {amplitude:g} m makes the wave of {float(freqs.max()):g} rad/s steeper than it can be "
+                   f"(height/length {steep:.3g} > 1/7, where waves break): take amplitude <= "
+                   f"{9.81 * 2 * math.pi / float(freqs.max()) ** 2 / 14:.3g} m")
     shortest = 2 * math.pi / float(freqs.max())
     if h > shortest / 4:
         raise _err(f"h = {h:g} s cannot follow the wave of {float(freqs.max()):g} rad/s (period {shortest:.4g} s): "

@@ -202,7 +202,15 @@ impl Params {
     /// Parse TOML text. A syntax error names the line and column.
     pub fn parse(text: &str) -> Result<Self> {
         let input: Table = text.parse().map_err(|e: toml::de::Error| {
-            Error::Parse(format!("TOML syntax error: {}", e.to_string().trim_end()))
+            // One line, as the scenario reader says it: the message and where (toml's own
+            // text quotes the line with a caret, over several lines).
+            let at = e.span().map_or(String::new(), |r| {
+                let before = &text[..r.start.min(text.len())];
+                let line = before.matches('\n').count() + 1;
+                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                format!(" (at line {line}, column {col})")
+            });
+            Error::Parse(format!("TOML syntax error: {}{at}", e.message().trim_end()))
         })?;
         Ok(Self::from_table(input))
     }

@@ -533,6 +533,10 @@ impl Model for VesselSystem<'_> {
                 .map(|(f, _)| {
                     let first = f.own_states().first().map_or("", |o| o.name.as_str());
                     match f.accounts().first() {
+                        _ if first.starts_with("observer_") => format!(
+                            "{} (its observer, control.feedback = \"observer\")",
+                            f.name()
+                        ),
                         Some(a) if a.name != f.name() && first.starts_with(a.name) => {
                             format!("{} (the subsystem {})", f.name(), a.name)
                         }

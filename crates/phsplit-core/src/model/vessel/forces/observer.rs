@@ -52,6 +52,36 @@ const T: &str = "observer";
 /// ω_c/ω₀ of the MSS example (1.1 rad/s at 0.8976 rad/s).
 const CUTOFF_RATIO: f64 = 1.1 / 0.8976;
 
+/// The wave model's and the filter's frequencies (rad/s).
+const FREQUENCY: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
+    lo: 0.0,
+    hi: 10.0,
+    lo_closed: false,
+    hi_closed: true,
+    why: "rad/s; a sea's waves are below 10 rad/s (periods above 0.6 s); a larger value is a frequency in other units",
+};
+
+/// The wave model's and the notch's relative damping.
+const RELATIVE_DAMPING: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
+    lo: 0.0,
+    hi: 10.0,
+    lo_closed: false,
+    hi_closed: true,
+    why: "a relative damping (1: critical); beyond 10 the filter is no notch",
+};
+
+/// How far an initial estimate may lie from the set point (m).
+const MAX_ESTIMATE_OFFSET: f64 = 1e4;
+
+/// An initial bias estimate: within what any environment can put on a vessel.
+const BIAS_RANGE: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
+    lo: -1e10,
+    hi: 1e10,
+    lo_closed: true,
+    hi_closed: true,
+    why: "no environment puts 10 GN or 10 GN m on a vessel",
+};
+
 /// Offsets of the state groups in the observer's 18 states.
 const XI1: usize = 0;
 const XI2: usize = 3;
@@ -125,12 +155,12 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
             )));
         }
     }
-    let omega0 = p.f64(T, "wave_frequency", "rad/s", Range::Positive)?;
+    let omega0 = p.f64(T, "wave_frequency", "rad/s", Range::Physical(&FREQUENCY))?;
     let lambda = p
-        .opt_f64(T, "wave_damping", "dimensionless", Range::Positive)?
+        .opt_f64(T, "wave_damping", "dimensionless", Range::Physical(&RELATIVE_DAMPING))?
         .unwrap_or(0.1);
     let zeta = p
-        .opt_f64(T, "notch_damping", "dimensionless", Range::Positive)?
+        .opt_f64(T, "notch_damping", "dimensionless", Range::Physical(&RELATIVE_DAMPING))?
         .unwrap_or(1.0);
     if zeta <= lambda {
         return Err(Error::InvalidInput(format!(
@@ -138,7 +168,7 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
         )));
     }
     let omega_c = p
-        .opt_f64(T, "cutoff_frequency", "rad/s", Range::Positive)?
+        .opt_f64(T, "cutoff_frequency", "rad/s", Range::Physical(&FREQUENCY))?
         .unwrap_or(CUTOFF_RATIO * omega0);
     if omega_c <= omega0 {
         return Err(Error::InvalidInput(format!(
@@ -180,20 +210,37 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
             )));
         }
     }
-    let initial_eta = match p.take_raw(T, "initial_estimate")? {
+    let initial_eta: Option<Vector3<f64>> = match p.take_raw(T, "initial_estimate")? {
         None => None,
         Some(_) => Some(
             p.vec3(T, "initial_estimate", None, "m, m, rad", Range::Finite)?
                 .into(),
         ),
     };
+    if let Some(e) = initial_eta {
+        let off = (e.x - g.position_reference.x).hypot(e.y - g.position_reference.y);
+        if off > MAX_ESTIMATE_OFFSET {
+            return Err(Error::InvalidInput(format!(
+                "observer.initial_estimate is {off:.4e} m from control.position_reference: an estimate must lie within {MAX_ESTIMATE_OFFSET} m of the set point"
+            )));
+        }
+        let psi = &crate::model::vessel::params::physical::ANGLE_RAD;
+        if !psi.contains(e.z) {
+            return Err(Error::InvalidInput(format!(
+                "observer.initial_estimate[2] must lie within {} (rad; {}), got {}",
+                psi.interval(),
+                psi.why,
+                e.z
+            )));
+        }
+    }
     let initial_bias: Vector3<f64> = p
         .vec3(
             T,
             "initial_bias",
             Some([0.0; 3]),
             "N, N, N m",
-            Range::Finite,
+            Range::Physical(&BIAS_RANGE),
         )?
         .into();
     let minv = m.try_inverse().ok_or_else(|| {

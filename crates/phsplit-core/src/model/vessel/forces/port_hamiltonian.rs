@@ -40,6 +40,9 @@ use nalgebra::{DMatrix, DVector, Vector3};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
+/// The largest storage a subsystem may start with (J).
+const MAX_INITIAL_STORAGE: f64 = 1e12;
+
 const T: &str = "port_hamiltonian";
 
 /// The degrees of freedom an input may take, in the order of `ν = (v, ω)`.
@@ -340,6 +343,15 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
             )))
         }
     };
+    // The storage it starts with: the largest ship at full speed carries about 3e10 J of
+    // kinetic energy; a subsystem that starts with more than 1e12 J is a slip of units.
+    let x0 = DVector::from_column_slice(&initial);
+    let h0 = 0.5 * x0.dot(&(&q * &x0));
+    if !(h0.is_finite() && h0 <= MAX_INITIAL_STORAGE) {
+        return Err(Error::InvalidInput(format!(
+            "{T}.initial stores {h0:.4e} J (½ xᵀQx): at most {MAX_INITIAL_STORAGE:e} J, a hundred times the kinetic energy of the largest ship at full speed; check the initial values and the units of Q"
+        )));
+    }
     let (name, accounts) = accounts_of(&name);
     // u = Bν.
     let rh = so3::hat(&Vector3::from(point));

@@ -74,6 +74,16 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
             }
             2.0 * z * (body.mass_matrix[(3, 3)] * roll_stiffness(p, body)?).sqrt()
         }
+        // Neither: a misspelling of one is named as such (else the table says what it needs).
+        (None, None) if quadratic == 0.0 => {
+            for key in ["linear", "critical_fraction"] {
+                let e = p.missing(T, key, "");
+                if e.to_string().contains("unknown field") {
+                    return Err(e);
+                }
+            }
+            0.0
+        }
         (None, None) => 0.0,
     };
     // Far above any hull's (a 300 m ship's critical roll damping is about 1e11 N m s): a slip of

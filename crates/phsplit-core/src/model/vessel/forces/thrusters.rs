@@ -171,7 +171,12 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
         wrapped.insert(name.clone(), Value::Table(t.clone()));
         let mut sub = Params::from_table(wrapped);
         let unit = read_unit(&mut sub, &name, length, beam)?;
-        lost_at.push(sub.opt_f64(&name, "lost_at", "s", Range::Finite)?);
+        lost_at.push(sub.opt_f64(
+            &name,
+            "lost_at",
+            "s",
+            Range::Physical(&crate::model::vessel::params::physical::TIME),
+        )?);
         // A key this kind does not read is refused, with the keys it does read.
         let out = sub.finish()?;
         if let Some(v) = out.get(&name) {

@@ -113,9 +113,9 @@ pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPi
                 .unwrap_or(default),
         )
     };
-    let cdn = opt(p, "drag_normal", "1", 1.2)?;
-    let cdt = opt(p, "drag_tangential", "1", 0.008)?;
-    let ca = opt(p, "added_mass", "1", 1.0)?;
+    let cdn = opt(p, "drag_normal", "dimensionless", 1.2)?;
+    let cdt = opt(p, "drag_tangential", "dimensionless", 0.008)?;
+    let ca = opt(p, "added_mass", "dimensionless", 1.0)?;
     let kb = opt(p, "seabed_stiffness", "Pa/m", 3.0e6)?;
     let cb = opt(p, "seabed_damping", "Pa s/m", 3.0e5)?;
     let axial = p.choice(T, "axial", &["tension_only", "tension_and_compression"])?;

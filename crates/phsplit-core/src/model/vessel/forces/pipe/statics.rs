@@ -159,6 +159,11 @@ impl Chain {
             let (sx, z) = at(i as f64 * self.rest);
             V3::new(top.x + dir.x * sx, top.y + dir.y * sx, z)
         };
+        if straight > length {
+            return Err(format!(
+                "pipe.anchor is {straight:.1} m from the hang-off point where the run starts, farther than pipe.length = {length} m: the pipe would start stretched beyond its length; lengthen it or move the anchor closer"
+            ));
+        }
         if straight >= length || ht <= 0.0 || self.weight <= 0.0 {
             return Ok((0..=n)
                 .map(|i| top + (self.anchor - top) * (i as f64 / n as f64))
