@@ -1558,3 +1558,20 @@ CATALOGUE += [
         _load_sweep_text(_SWEEP_HEAD + b'mode = "random"\nsamples = 2\n[sweep.parameters]\n"vessel.mass" = {low = -1.0, high = 7e6}\n'),
         E, ("sweep.parameters.vessel.mass = -1", "> 0")),
 ]
+
+
+def _rao_of(scenario_name: str) -> Callable[[], object]:
+    def run():
+        from phsplit import scenario as scn
+        from phsplit import seakeeping
+
+        return seakeeping.rao(scn.load(scenario_name).vessel, [0.56], 90.0, check_only=True)
+    return run
+
+
+CATALOGUE += [
+    Bad("RAO of a vessel held by a pipe", _rao_of("pipelay"), E, ("[pipe]", "without it")),
+    Bad("RAO adding a fluid memory to a vessel with a subsystem",
+        lambda: __import__("phsplit.seakeeping").seakeeping.rao(_ph_dict()(), [0.56], 90.0, check_only=True), E,
+        ("port-Hamiltonian subsystem", "fluid_memory=False")),
+]

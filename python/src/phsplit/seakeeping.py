@@ -336,6 +336,16 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
         frequency_rao(vessel, float(w), heading, dataset, data=data, amplitude=amplitude)
     if not (fluid_memory is True or fluid_memory is False or isinstance(fluid_memory, radiation.FluidMemory)):
         raise _err(f"fluid_memory must be True, False or a FluidMemory, got {type(fluid_memory).__name__}")
+    tables = vessel.to_dict()
+    if "pipe" in tables:
+        raise _err("the RAO is the free vessel's in regular waves: the vessel has a [pipe], which holds it; "
+                   "give the vessel without it")
+    if fluid_memory is not False and "port_hamiltonian" in tables:
+        name = tables["port_hamiltonian"].get("name")
+        raise _err(f"the vessel already has a port-Hamiltonian subsystem ({name!r}"
+                   + (": its fluid memory" if name == "radiation" else "")
+                   + "), and the RAO would add the fluid memory's: run it with fluid_memory=False "
+                   "(phsplit rao --no-fluid-memory)")
     if check_only:
         return None
     if fluid_memory is True:

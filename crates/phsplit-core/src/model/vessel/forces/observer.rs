@@ -40,6 +40,9 @@
 //! changes by what the ports supply less what it dissipates, to round-off.
 
 use super::sensors::{self, Sensors};
+use parts::{gains, states};
+
+mod parts;
 use super::{Frozen, Output, OwnLinear, OwnState, HELD};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
@@ -62,13 +65,14 @@ const FREQUENCY: crate::model::vessel::params::Physical = crate::model::vessel::
 };
 
 /// The wave model's and the notch's relative damping.
-const RELATIVE_DAMPING: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
-    lo: 0.0,
-    hi: 10.0,
-    lo_closed: false,
-    hi_closed: true,
-    why: "a relative damping (1: critical); beyond 10 the filter is no notch",
-};
+const RELATIVE_DAMPING: crate::model::vessel::params::Physical =
+    crate::model::vessel::params::Physical {
+        lo: 0.0,
+        hi: 10.0,
+        lo_closed: false,
+        hi_closed: true,
+        why: "a relative damping (1: critical); beyond 10 the filter is no notch",
+    };
 
 /// How far an initial estimate may lie from the set point (m).
 const MAX_ESTIMATE_OFFSET: f64 = 1e4;
@@ -157,10 +161,20 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
     }
     let omega0 = p.f64(T, "wave_frequency", "rad/s", Range::Physical(&FREQUENCY))?;
     let lambda = p
-        .opt_f64(T, "wave_damping", "dimensionless", Range::Physical(&RELATIVE_DAMPING))?
+        .opt_f64(
+            T,
+            "wave_damping",
+            "dimensionless",
+            Range::Physical(&RELATIVE_DAMPING),
+        )?
         .unwrap_or(0.1);
     let zeta = p
-        .opt_f64(T, "notch_damping", "dimensionless", Range::Physical(&RELATIVE_DAMPING))?
+        .opt_f64(
+            T,
+            "notch_damping",
+            "dimensionless",
+            Range::Physical(&RELATIVE_DAMPING),
+        )?
         .unwrap_or(1.0);
     if zeta <= lambda {
         return Err(Error::InvalidInput(format!(
@@ -187,9 +201,8 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
             Range::NonNegative,
         )?
         .into();
-    let omega_b = p
-        .opt_f64(T, "bias_bandwidth", "rad/s", Range::Positive)?
-        .unwrap_or(omega0 / 5.0);
+    let given_b = p.opt_f64(T, "bias_bandwidth", "rad/s", Range::Physical(&FREQUENCY))?;
+    let omega_b = given_b.unwrap_or(omega0 / 5.0);
     let mut opt = |key: &str, unit: &str| -> crate::Result<Option<Vector3<f64>>> {
         match p.take_raw(T, key)? {
             None => Ok(None),
@@ -200,7 +213,14 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
     let k3 = opt("bias_gain", "N/(m s), N/(m s), N m/(rad s)")?;
     let idx = [0, 1, 5];
     let m = Matrix3::from_fn(|i, j| body.mass_matrix[(idx[i], idx[j])]);
-    let (k4, k3) = gains(k4, k3, omega_b, omega_c, &m, &damping)?;
+    let (k4, k3) =
+        gains(k4, k3, omega_b, omega_c, &m, &damping).map_err(|e| match (e, given_b) {
+            (Error::InvalidInput(msg), None) => Error::InvalidInput(msg.replace(
+                "bias_bandwidth = ",
+                "bias_bandwidth (not given: wave_frequency / 5) = ",
+            )),
+            (e, _) => e,
+        })?;
     for i in 0..3 {
         let r = k3[i] / k4[i];
         if !(r > 1.0 / bias_time && r < omega0) {
@@ -284,114 +304,6 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
     };
     o.template = o.rows(0.0, true, None);
     Ok(o)
-}
-
-/// K₄ and K₃ as given, or placed: the low-frequency error dynamics of each degree of freedom
-/// (below the wave filter, `η̃ ≈ R ν̃ / K₂`) are `M s² + (D + K₄/K₂) s + K₃/K₂ = 0`; critically
-/// damped at ω_b they need `K₃ = K₂ M ω_b²`, `K₄ = K₂ (2 M ω_b − D)`.
-fn gains(
-    k4: Option<Vector3<f64>>,
-    k3: Option<Vector3<f64>>,
-    omega_b: f64,
-    k2: f64,
-    m: &Matrix3<f64>,
-    damping: &Vector3<f64>,
-) -> crate::Result<(Vector3<f64>, Vector3<f64>)> {
-    if let (Some(k4), Some(k3)) = (k4, k3) {
-        return Ok((k4, k3));
-    }
-    let mut p4 = Vector3::zeros();
-    let mut p3 = Vector3::zeros();
-    for (i, dof) in ["surge", "sway", "yaw"].iter().enumerate() {
-        let mi = m[(i, i)];
-        let excess = 2.0 * mi * omega_b - damping[i];
-        if excess <= 0.0 {
-            return Err(Error::InvalidInput(format!(
-                "observer: in {dof} the model damping ({:.4e}) alone exceeds the critical damping of the bias estimate at bias_bandwidth = {omega_b} rad/s ({:.4e}): raise bias_bandwidth, or give velocity_gain and bias_gain",
-                damping[i],
-                2.0 * mi * omega_b
-            )));
-        }
-        p4[i] = k2 * excess;
-        p3[i] = k2 * mi * omega_b * omega_b;
-    }
-    Ok((k4.unwrap_or(p4), k3.unwrap_or(p3)))
-}
-
-fn states(sensed: bool) -> Vec<OwnState> {
-    let mut out = Vec::with_capacity(N + sensors::N);
-    let mut push = |name: &str, unit: &str, long: &str| {
-        out.push(OwnState {
-            name: name.into(),
-            unit: unit.into(),
-            long_name: long.into(),
-            initial: 0.0,
-        })
-    };
-    for (d, u) in [("x", "m s"), ("y", "m s"), ("yaw", "rad s")] {
-        push(
-            &format!("observer_wave_state_{d}"),
-            u,
-            &format!("observer's first wave-model state in {d} (the integral of the wave motion)"),
-        );
-    }
-    for (d, u) in [("x", "m"), ("y", "m"), ("yaw", "rad")] {
-        push(
-            &format!("observer_wave_{d}"),
-            u,
-            &format!("observer's estimate of the wave-frequency motion in {d} (spatial)"),
-        );
-    }
-    push(
-        "observer_x",
-        "m",
-        "observer's estimate of the low-frequency position x (spatial)",
-    );
-    push(
-        "observer_y",
-        "m",
-        "observer's estimate of the low-frequency position y (spatial)",
-    );
-    push(
-        "observer_heading",
-        "rad",
-        "observer's estimate of the low-frequency heading",
-    );
-    for (d, u) in [("x", "N"), ("y", "N"), ("yaw", "N m")] {
-        push(
-            &format!("observer_bias_{d}"),
-            u,
-            &format!("observer's estimate of the slowly varying force in {d} (spatial frame)"),
-        );
-    }
-    push(
-        "observer_surge_velocity",
-        "m s-1",
-        "observer's estimate of the surge velocity",
-    );
-    push(
-        "observer_sway_velocity",
-        "m s-1",
-        "observer's estimate of the sway velocity",
-    );
-    push(
-        "observer_yaw_rate",
-        "rad s-1",
-        "observer's estimate of the yaw rate",
-    );
-    for (d, u) in [("x", "m s"), ("y", "m s"), ("heading", "rad s")] {
-        push(
-            &format!("control_integral_{d}"),
-            u,
-            &format!("integral of the estimated error in {d} (the controller's I term)"),
-        );
-    }
-    if sensed {
-        for (name, unit, long) in Sensors::states() {
-            push(name, unit, long);
-        }
-    }
-    out
 }
 
 /// `R(ψ)` in the horizontal plane, yaw unchanged.
