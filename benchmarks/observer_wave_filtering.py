@@ -6,7 +6,12 @@ controller on the vessel's state (the paper's), and on the estimates of the obse
 vessel's). Prints and writes (benchmarks/results/observer_wave_filtering.md) the controller's
 force spectrum in the wave band (Welch, 0.45-1.3 rad/s, after a 300 s transient) in surge, sway
 and yaw, the ratio in dB, and the horizontal position excursion (max, RMS; whole and below
-0.35 rad/s). Usage: ``python benchmarks/observer_wave_filtering.py [--t-end 3600] [--bias-bandwidth W]``."""
+0.35 rad/s), for two controllers, each the same in both runs: the paper's PID of dp-weather
+(a bandwidth of 0.25 rad/s, stiff enough to damp the wave motion itself), and a PID placed for
+an observer in the loop by Fossen's pole placement (Fossen 2021, §15.3: ``Kp = m ωn²``,
+``Kd = 2ζωn m − d``, ``Ki = ωn Kp / 10``, with the vessel's mass matrix and damping; ωn 0.06
+rad/s and ζ 0.9 in surge and sway, 0.1 rad/s and 1 in yaw). Usage:
+``python benchmarks/observer_wave_filtering.py [--t-end 3600] [--bias-bandwidth W]``."""
 from __future__ import annotations
 
 import argparse
@@ -26,9 +31,30 @@ BAND = (0.45, 1.3)   # rad/s: the sea's spectrum (Tp 9 s, JONSWAP) above 5 % of 
 LOW = 0.35           # rad/s: below the wave band
 
 
-def run(feedback: str, t_end: float, bias_bandwidth: float | None):
+#: Pole placement (Fossen 2021, §15.3) in surge and sway, and in yaw: (ωn rad/s, ζ).
+PLACED = {"surge_sway": (0.06, 0.9), "yaw": (0.1, 1.0)}
+
+
+def placed_gains(d: dict, mass_matrix: np.ndarray) -> dict:
+    """``Kp = m ωn²``, ``Kd = 2ζωn m − d`` (at least 0), ``Ki = ωn Kp / 10`` per DOF."""
+    v = d["vessel"]
+    out = {k: [0.0, 0.0, 0.0] for k in ("kp_translational", "kd_translational", "ki_translational",
+                                         "kp_rotational", "kd_rotational", "ki_rotational")}
+    for i, (kind, m, dmp) in enumerate([("surge_sway", mass_matrix[0, 0], v["damping_translational"][0]),
+                                         ("surge_sway", mass_matrix[1, 1], v["damping_translational"][1]),
+                                         ("yaw", mass_matrix[5, 5], v["damping_rotational"][2])]):
+        wn, zeta = PLACED[kind]
+        kp, kd = m * wn ** 2, max(2 * zeta * wn * m - dmp, 0.0)
+        part, j = ("translational", i) if i < 2 else ("rotational", 2)
+        out[f"kp_{part}"][j], out[f"kd_{part}"][j], out[f"ki_{part}"][j] = kp, kd, wn * kp / 10
+    return out
+
+
+def run(feedback: str, t_end: float, bias_bandwidth: float | None, controller: str = "paper"):
     sc = scenario.load("dp-weather")
     d = sc.vessel.to_dict()
+    if controller == "placed":
+        d["control"].update(placed_gains(d, sc.vessel.mass_matrix))
     if feedback == "observer":
         d["control"]["feedback"] = "observer"
         v = d["vessel"]
@@ -67,23 +93,29 @@ def main():
     ap.add_argument("--bias-bandwidth", type=float, default=None)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "observer_wave_filtering.md"))
     a = ap.parse_args()
-    true_state, ref = run("true_state", a.t_end, None)
-    observer, _ = run("observer", a.t_end, a.bias_bandwidth)
-    mt, mo = measure(true_state, ref), measure(observer, ref)
     lines = [f"# Wave filtering of the passive observer, dp-weather ({a.t_end:.0f} s, sp4, h = 0.5 s)", "",
              f"{datetime.date.today()}, {platform.machine()} {platform.system()}, phsplit {phsplit.__version__}; "
              f"`python benchmarks/observer_wave_filtering.py --t-end {a.t_end:.0f}"
-             + (f" --bias-bandwidth {a.bias_bandwidth}" if a.bias_bandwidth else "") + "`", "",
-             f"Controller force power in the wave band {BAND[0]}-{BAND[1]} rad/s (Welch, after 300 s):", "",
-             "| | true state | observer | drop |", "|---|---|---|---|"]
-    for k in ("surge", "sway", "yaw"):
-        lines.append(f"| {k} | {mt[k]:.3e} | {mo[k]:.3e} | {10 * math.log10(mt[k] / mo[k]):.1f} dB |")
-    lines += ["", "Horizontal excursion from the set point (m):", "",
-              "| | true state | observer | ratio |", "|---|---|---|---|"]
-    for k, label in (("max", "max"), ("rms", "RMS"), ("lf_max", f"max below {LOW} rad/s"),
-                     ("lf_rms", f"RMS below {LOW} rad/s")):
-        lines.append(f"| {label} | {mt[k]:.3f} | {mo[k]:.3f} | {mo[k] / mt[k]:.2f} |")
-    text = "\n".join(lines) + "\n"
+             + (f" --bias-bandwidth {a.bias_bandwidth}" if a.bias_bandwidth else "") + "`", ""]
+    for controller, title in (("paper", "the paper's PID (dp-weather's gains)"),
+                              ("placed", "a PID placed for the observer (Fossen 2021 §15.3: surge and sway "
+                                         f"ωn {PLACED['surge_sway'][0]} rad/s ζ {PLACED['surge_sway'][1]}, yaw ωn "
+                                         f"{PLACED['yaw'][0]} rad/s ζ {PLACED['yaw'][1]})")):
+        true_state, ref = run("true_state", a.t_end, None, controller)
+        observer, _ = run("observer", a.t_end, a.bias_bandwidth, controller)
+        mt, mo = measure(true_state, ref), measure(observer, ref)
+        lines += [f"## The same controller in both runs: {title}", "",
+                  f"Controller force power in the wave band {BAND[0]}-{BAND[1]} rad/s (Welch, after 300 s):", "",
+                  "| | true state | observer | drop |", "|---|---|---|---|"]
+        for k in ("surge", "sway", "yaw"):
+            lines.append(f"| {k} | {mt[k]:.3e} | {mo[k]:.3e} | {10 * math.log10(mt[k] / mo[k]):.1f} dB |")
+        lines += ["", "Horizontal excursion from the set point (m):", "",
+                  "| | true state | observer | ratio |", "|---|---|---|---|"]
+        for k, label in (("max", "max"), ("rms", "RMS"), ("lf_max", f"max below {LOW} rad/s"),
+                         ("lf_rms", f"RMS below {LOW} rad/s")):
+            lines.append(f"| {label} | {mt[k]:.3f} | {mo[k]:.3f} | {mo[k] / mt[k]:.2f} |")
+        lines.append("")
+    text = "\n".join(lines)
     print(text)
     out = Path(a.out)
     with tempfile.NamedTemporaryFile("w", dir=out.parent, delete=False, suffix=".tmp") as f:

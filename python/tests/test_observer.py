@@ -64,6 +64,9 @@ class ObserverField:
         self.k1a, self.k1b, self.k2 = -2 * (zeta - lam) * wc / W0, 2 * W0 * (zeta - lam), wc
         self.k3 = wc * M * wb ** 2
         self.k4 = wc * (2 * M * wb - D)
+        # the same in x and y: the mean of the surge and sway placements (the docs)
+        self.k3[:2] = self.k3[:2].mean()
+        self.k4[:2] = self.k4[:2].mean()
         self.lam, self.T, self.M, self.D = lam, T, M, D
 
     def __call__(self, t, y):

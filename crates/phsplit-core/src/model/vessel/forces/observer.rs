@@ -22,7 +22,8 @@
 //! the low-frequency error dynamics of each degree of freedom (below the wave filter,
 //! `η̃ ≈ R ν̃/K₂`: `M s² + (D + K₄/K₂) s + K₃/K₂ = 0`) critically damped at the bias bandwidth
 //! ω_b (default ω₀/5): `K₃ = K₂ M ω_b²`, `K₄ = K₂ (2 M ω_b − D)`, so `K₃/K₄ ≈ ω_b/2`, inside
-//! the rule.
+//! the rule; in x and y the mean of the surge and sway placements, so that `R(ψ)ᵀ K₄ ỹ` turns
+//! no surge residual into sway at any heading.
 //!
 //! The controller acts on the estimates: `τ = −Rᵀ(Kp e + Ki q) − Rᵀ Kd R ν̂` in surge, sway
 //! and yaw (body frame), `e = η̂ − η_ref` (heading the short way round the set point),

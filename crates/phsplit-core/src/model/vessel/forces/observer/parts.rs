@@ -7,7 +7,7 @@ use super::N;
 use crate::error::Error;
 use nalgebra::{Matrix3, Vector3};
 
-/// K₄ and K₃ as given, or placed: the low-frequency error dynamics of each degree of freedom
+/// K₄ and K₃ as given, or placed (the same in x and y, below): the low-frequency error dynamics of each degree of freedom
 /// (below the wave filter, `η̃ ≈ R ν̃ / K₂`) are `M s² + (D + K₄/K₂) s + K₃/K₂ = 0`; critically
 /// damped at ω_b they need `K₃ = K₂ M ω_b²`, `K₄ = K₂ (2 M ω_b − D)`.
 pub(super) fn gains(
@@ -35,6 +35,15 @@ pub(super) fn gains(
         }
         p4[i] = k2 * excess;
         p3[i] = k2 * mi * omega_b * omega_b;
+    }
+    // The same in x and y, placed with the mean of surge and sway: `K₃`, `K₄` act on the
+    // spatial residual and reach the hull's axes through `R(ψ)ᵀ`; unequal, they would turn a
+    // surge residual into a sway estimate at every heading off the axes (with the paper's
+    // surge and sway damping, 2 % of the surge wave motion into sway at 31°).
+    for p in [&mut p4, &mut p3] {
+        let mean = 0.5 * (p[0] + p[1]);
+        p[0] = mean;
+        p[1] = mean;
     }
     Ok((k4.unwrap_or(p4), k3.unwrap_or(p3)))
 }
