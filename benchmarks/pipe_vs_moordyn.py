@@ -63,6 +63,8 @@ def vessel(p: dict, n: int) -> phsplit.Vessel:
     g, rho = tables["vessel"]["gravity"], tables["vessel"]["water_density"]
     assert (g, rho) == (p["g"], p["rho_w"]), (g, rho)
     tables["pipe"] = pipe_table(p, n)
+    # at the origin, upright: the hang-off point (MoorDyn's fairlead) is where the drive starts
+    tables["initial"].update(position=[0.0, 0.0, 0.0], euler=[0.0, 0.0, 0.0])
     return phsplit.Vessel.from_dict(tables)
 
 

@@ -48,6 +48,8 @@ def md():
 def vessel(p):
     tables = phsplit.Vessel.preset("paper").to_dict()
     assert tables["vessel"]["gravity"] == p["g"] and tables["vessel"]["water_density"] == p["rho_w"]
+    # at the origin, upright: the hang-off point (MoorDyn's fairlead) is where the drive starts
+    tables["initial"].update(position=[0.0, 0.0, 0.0], euler=[0.0, 0.0, 0.0])
     tables["pipe"] = dict(model="lumped_mass", length=p["L"], segments=N, axial_stiffness=p["EA"],
                           mass=p["mu"], diameter=p["d"], water_depth=p["depth"],
                           hang_off=list(p["fairlead"]), anchor=p["anchor"][:2], drag_normal=p["Cd"],

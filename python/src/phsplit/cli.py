@@ -353,6 +353,15 @@ def _simulate(args) -> int:
     from .files import BusyError, PartialFile
     from .plotting import plot_dp
 
+    if args.scenario and args.method in ("euler", "heun", "rk4"):
+        # Refused before the scenario's fluid memory is fitted (tens of seconds): its states are
+        # the splitting's to carry (the core refuses any other vessel with states of its own).
+        raw = scn._read_toml(scn.resolve(args.scenario), "scenario file")
+        waves = raw.get("environment", {}).get("waves", {}) if isinstance(raw.get("environment"), dict) else {}
+        if isinstance(waves, dict) and waves.get("fluid_memory") is True:
+            raise UsageError(f"--method {args.method}: the scenario's fluid memory (environment.waves.fluid_memory) "
+                             "keeps states of its own, which the Runge–Kutta kernel does not carry: use a splitting "
+                             "method (lie, sp2, sp4, ...)")
     if args.scenario:
         # --vessel replaces the scenario's vessel; its environment, operation and overrides stay.
         try:

@@ -182,6 +182,12 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
         if isinstance(over.get(table), Mapping):
             over[table] = in_radians(dict(over[table]), table, key, path)
     if "environment" in data:
+        waves = data["environment"].get("waves") if isinstance(data["environment"], Mapping) else None
+        if (isinstance(waves, Mapping) and waves.get("fluid_memory") is True
+                and ("port_hamiltonian" in over or "port_hamiltonian" in base.to_dict())):
+            # refused before the memory is fitted (tens of seconds)
+            raise _core.InvalidInputError(f"{path}: environment.waves.fluid_memory: the vessel already has a "
+                                          f"port-Hamiltonian subsystem, and a vessel holds one")
         hull = overlay(base.to_dict(), {"vessel": over["vessel"]} if "vessel" in over else {})
         env_tables = _environment(data["environment"], path, base_dir, hull)
         if "port_hamiltonian" in env_tables and ("port_hamiltonian" in over or "port_hamiltonian" in base.to_dict()):

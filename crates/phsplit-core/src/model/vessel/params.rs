@@ -57,10 +57,20 @@ impl Physical {
         format!(
             "{}{}, {}{}",
             if self.lo_closed { "[" } else { "(" },
-            self.lo,
-            self.hi,
+            compact(self.lo),
+            compact(self.hi),
             if self.hi_closed { "]" } else { ")" }
         )
+    }
+}
+
+/// A number as a message says it: in full below 1e7, else in scientific notation (`1e13`, not
+/// fourteen digits; `1e300`, not three hundred).
+pub fn compact(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && (v.abs() >= 1e7 || v.abs() < 1e-4) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
     }
 }
 
@@ -170,9 +180,10 @@ impl Range {
                 )));
             }
             return Err(Error::InvalidInput(format!(
-                "{name} must lie within {} ({unit}; {}), got {v}",
+                "{name} must lie within {} ({unit}; {}), got {}",
                 r.interval(),
-                r.why
+                r.why,
+                compact(v)
             )));
         }
         let what = match self {

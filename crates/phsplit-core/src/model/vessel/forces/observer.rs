@@ -75,6 +75,24 @@ const RELATIVE_DAMPING: crate::model::vessel::params::Physical =
         why: "a relative damping (1: critical); beyond 10 the filter is no notch",
     };
 
+/// The model's damping: a large ship's linear yaw damping is about 1e10 kg m²/s.
+const MODEL_DAMPING: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
+    lo: 0.0,
+    hi: 1e13,
+    lo_closed: true,
+    hi_closed: true,
+    why: "a thousand times a large ship's yaw damping",
+};
+
+/// K₃ and K₄ given: far above any placement's (a large ship's K₄ in yaw is about 1e11).
+const GAIN: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
+    lo: 0.0,
+    hi: 1e16,
+    lo_closed: false,
+    hi_closed: true,
+    why: "far above what any placement gives",
+};
+
 /// How far an initial estimate may lie from the set point (m).
 const MAX_ESTIMATE_OFFSET: f64 = 1e4;
 
@@ -199,7 +217,7 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
             "damping",
             None,
             "kg/s, kg/s, kg m^2/s",
-            Range::NonNegative,
+            Range::Physical(&MODEL_DAMPING),
         )?
         .into();
     let given_b = p.opt_f64(T, "bias_bandwidth", "rad/s", Range::Physical(&FREQUENCY))?;
@@ -207,7 +225,7 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
     let mut opt = |key: &str, unit: &str| -> crate::Result<Option<Vector3<f64>>> {
         match p.take_raw(T, key)? {
             None => Ok(None),
-            Some(_) => Ok(Some(p.vec3(T, key, None, unit, Range::Positive)?.into())),
+            Some(_) => Ok(Some(p.vec3(T, key, None, unit, Range::Physical(&GAIN))?.into())),
         }
     };
     let k4 = opt("velocity_gain", "N/m, N/m, N m/rad")?;

@@ -84,7 +84,16 @@ pub fn build(p: &mut Params, body: &super::super::Body) -> crate::Result<Arc<dyn
 
 /// [`build`]'s pipe itself (for a line driven at its top alone: `phsplit.pipe`).
 pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPipe> {
-    const T: &str = "pipe";
+    /// A pipe's or line's outer diameter (m): the largest pipelines and risers are under 2 m.
+const DIAMETER: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
+    lo: 0.0,
+    hi: 5.0,
+    lo_closed: false,
+    hi_closed: true,
+    why: "no pipe or line laid from a vessel is 5 m across",
+};
+
+const T: &str = "pipe";
     let length = p.f64(T, "length", "m", Range::Positive)?;
     let n = p.f64(T, "segments", "an integer", Range::Positive)?;
     if n.fract() != 0.0 || !(2.0..=MAX_SEGMENTS as f64).contains(&n) {
@@ -95,7 +104,7 @@ pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPi
     let segments = n as usize;
     let ea = p.f64(T, "axial_stiffness", "N", Range::Positive)?;
     let mass = p.f64(T, "mass", "kg/m", Range::Positive)?;
-    let d = p.f64(T, "diameter", "m", Range::Positive)?;
+    let d = p.f64(T, "diameter", "m", Range::Physical(&DIAMETER))?;
     let (depth, hang_off) = super::depth_and_hang_off(p)?;
     let anchor = p
         .rows(T, "anchor", 1, "m, spatial x and y", Range::Finite)?
