@@ -76,13 +76,14 @@ const RELATIVE_DAMPING: crate::model::vessel::params::Physical =
     };
 
 /// The model's damping: a large ship's linear yaw damping is about 1e10 kg m²/s.
-const MODEL_DAMPING: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
-    lo: 0.0,
-    hi: 1e13,
-    lo_closed: true,
-    hi_closed: true,
-    why: "a thousand times a large ship's yaw damping",
-};
+const MODEL_DAMPING: crate::model::vessel::params::Physical =
+    crate::model::vessel::params::Physical {
+        lo: 0.0,
+        hi: 1e13,
+        lo_closed: true,
+        hi_closed: true,
+        why: "a thousand times a large ship's yaw damping",
+    };
 
 /// K₃ and K₄ given: far above any placement's (a large ship's K₄ in yaw is about 1e11).
 const GAIN: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
@@ -225,7 +226,9 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
     let mut opt = |key: &str, unit: &str| -> crate::Result<Option<Vector3<f64>>> {
         match p.take_raw(T, key)? {
             None => Ok(None),
-            Some(_) => Ok(Some(p.vec3(T, key, None, unit, Range::Physical(&GAIN))?.into())),
+            Some(_) => Ok(Some(
+                p.vec3(T, key, None, unit, Range::Physical(&GAIN))?.into(),
+            )),
         }
     };
     let k4 = opt("velocity_gain", "N/m, N/m, N m/rad")?;

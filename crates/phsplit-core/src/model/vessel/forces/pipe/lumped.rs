@@ -82,9 +82,7 @@ pub fn build(p: &mut Params, body: &super::super::Body) -> crate::Result<Arc<dyn
     Ok(Arc::new(read(p, body)?))
 }
 
-/// [`build`]'s pipe itself (for a line driven at its top alone: `phsplit.pipe`).
-pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPipe> {
-    /// A pipe's or line's outer diameter (m): the largest pipelines and risers are under 2 m.
+/// A pipe's or line's outer diameter (m): the largest pipelines and risers are under 2 m.
 const DIAMETER: crate::model::vessel::params::Physical = crate::model::vessel::params::Physical {
     lo: 0.0,
     hi: 5.0,
@@ -93,7 +91,9 @@ const DIAMETER: crate::model::vessel::params::Physical = crate::model::vessel::p
     why: "no pipe or line laid from a vessel is 5 m across",
 };
 
-const T: &str = "pipe";
+/// [`build`]'s pipe itself (for a line driven at its top alone: `phsplit.pipe`).
+pub fn read(p: &mut Params, body: &super::super::Body) -> crate::Result<LumpedPipe> {
+    const T: &str = "pipe";
     let length = p.f64(T, "length", "m", Range::Positive)?;
     let n = p.f64(T, "segments", "an integer", Range::Positive)?;
     if n.fract() != 0.0 || !(2.0..=MAX_SEGMENTS as f64).contains(&n) {
