@@ -314,10 +314,24 @@ def _directions(directions: Any) -> np.ndarray:
         _bad("directions", f"must be a non-empty list of finite numbers (degrees), got {directions!r}")
     if np.any((d < 0) | (d >= 360)):
         _bad("directions", f"must lie in [0, 360) degrees (where the environment comes from, off the bow, clockwise), "
-             f"got {[float(x) for x in d[(d < 0) | (d >= 360)]][0]:g}")
+             f"got {float(d[(d < 0) | (d >= 360)][0]):g}")
     if len(np.unique(d)) != len(d):
         _bad("directions", "must not repeat a direction")
     return d
+
+
+def _vessel_of(vessel: Any) -> Vessel:
+    """A :class:`Vessel` from a vessel, a :class:`~phsplit.scenario.Scenario`, or a scenario file
+    or shipped scenario name."""
+    from .scenario import Scenario, load
+
+    if isinstance(vessel, str) or hasattr(vessel, "__fspath__"):
+        vessel = load(vessel).vessel
+    elif isinstance(vessel, Scenario):
+        vessel = vessel.vessel
+    if not isinstance(vessel, Vessel):
+        _bad("vessel", f"must be a phsplit.Vessel, a Scenario, or a scenario file or name, got {type(vessel).__name__}")
+    return vessel
 
 
 def held(vessel: Vessel, demand: Sequence[float], lost: Sequence[int] = ()) -> dict:
@@ -363,14 +377,8 @@ def capability(vessel: Any, directions: Any = None, failures: Any = "single",
     import xarray as xr
 
     from . import cf
-    from .scenario import Scenario, load
 
-    if isinstance(vessel, (str,)) or hasattr(vessel, "__fspath__"):
-        vessel = load(vessel).vessel
-    elif isinstance(vessel, Scenario):
-        vessel = vessel.vessel
-    if not isinstance(vessel, Vessel):
-        _bad("vessel", f"must be a phsplit.Vessel, a Scenario, or a scenario file or name, got {type(vessel).__name__}")
+    vessel = _vessel_of(vessel)
     if isinstance(tolerance, (np.integer, np.floating)) and not isinstance(tolerance, np.bool_):
         tolerance = float(tolerance)
     if not (isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool)
@@ -500,15 +508,9 @@ def hold(vessel: Any, direction: float, wind_speed: float, lost: Sequence[int] =
     Where the thrusters can balance the load (at or below the static limit) the vessel stays on
     its set point; beyond it they saturate and the vessel is pushed off (test_osv_capability.py).
     """
-    from .scenario import Scenario, load
     from .simulate import simulate
 
-    if isinstance(vessel, (str,)) or hasattr(vessel, "__fspath__"):
-        vessel = load(vessel).vessel
-    elif isinstance(vessel, Scenario):
-        vessel = vessel.vessel
-    if not isinstance(vessel, Vessel):
-        _bad("vessel", f"must be a phsplit.Vessel, a Scenario, or a scenario file or name, got {type(vessel).__name__}")
+    vessel = _vessel_of(vessel)
     d = float(_directions([direction])[0])
     if not (isinstance(wind_speed, (int, float, np.integer, np.floating)) and not isinstance(wind_speed, (bool, np.bool_))
             and 0.0 <= float(wind_speed) <= MAX_WIND):
