@@ -184,7 +184,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "weight": ("-", "1", "cost of its thrust in the allocation, > 0"),
         "thrust_rate": ("N/s", "none", "fastest change of thrust, > 0"),
         "turn_rate": ("degrees/s", "none", "azimuth: fastest turn, > 0"),
-        "lost_at": ("s", "none", "the time the thruster is lost: from then it delivers nothing and the allocation redistributes the demand (§5.8); within ±1e9 s"),
+        "lost_at": ("s", "none", "the time the thruster is lost: from then it delivers nothing and the allocation redistributes the demand (§5.8); within ±1e9 s, at or before the start: lost from the start"),
     },
     "waves": {
         "frequencies": ("rad/s", REQ, "ω_k of the sea state's components, > 0 (realised by `phsplit.sea`; §5.9)"),
