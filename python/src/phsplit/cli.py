@@ -810,10 +810,9 @@ def _failures(args) -> int:
             raise UsageError(f"--t-end must be a finite time after the start ({st.t_span[0]:g} s), got {args.t_end:g}")
         st = dataclasses.replace(st, t_span=(st.t_span[0], args.t_end))
     try:
-        n = len(check_failure_study(sc.vessel, st, args.at))
+        n = len(check_failure_study(sc.vessel, st, args.at, at_name="--at"))
     except phsplit.InvalidInputError as e:
-        raise UsageError(str(e).replace("single_failures: at = ", "--at ").replace("single_failures: at ", "--at ")
-                         .replace("single_failures: ", "")) from None
+        raise UsageError(str(e).removeprefix("single_failures: ")) from None
     print(f"{sc.name}: {n + 1} runs on [{st.t_span[0]:g}, {st.t_span[1]:g}] s, each thruster lost in turn at "
           f"t = {args.at:g} s", flush=True)
     study = single_failures(sc.vessel, st, at=args.at)

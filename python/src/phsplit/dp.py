@@ -132,8 +132,9 @@ class FailureStudy:
         return "\n".join(lines)
 
 
-def check_failure_study(vessel: Vessel, settings: Settings, at: float) -> list:
-    """What :func:`single_failures` refuses, before anything runs: its thruster units."""
+def check_failure_study(vessel: Vessel, settings: Settings, at: float, at_name: str = "single_failures: at") -> list:
+    """What :func:`single_failures` refuses, before anything runs: its thruster units.
+    ``at_name``: how the messages name ``at`` (the CLI's ``--at``)."""
     if not isinstance(vessel, Vessel):
         raise _core.InvalidInputError(f"single_failures: vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
     if not isinstance(settings, Settings):
@@ -144,7 +145,7 @@ def check_failure_study(vessel: Vessel, settings: Settings, at: float) -> list:
         raise _core.InvalidInputError("single_failures: the vessel has no [thrusters] to lose")
     t0, t1 = settings.t_span
     if isinstance(at, bool) or not isinstance(at, (int, float)) or not (t0 <= at < t1):
-        raise _core.InvalidInputError(f"single_failures: at must be a time within the run's t_span [{t0:g}, {t1:g}) s, got {at!r}")
+        raise _core.InvalidInputError(f"{at_name} must be a time within the run's t_span [{t0:g}, {t1:g}) s, got {at!r}")
     already = [i for i, u in enumerate(units) if "lost_at" in u]
     if already:
         raise _core.InvalidInputError(
@@ -155,7 +156,7 @@ def check_failure_study(vessel: Vessel, settings: Settings, at: float) -> list:
     n_after = math.floor((t1 - at) / (h * every) + 1e-9)
     if n_after < 1:
         raise _core.InvalidInputError(
-            f"single_failures: at = {at:g} s leaves fewer than two saved states before the run ends at {t1:g} s "
+            f"{at_name} = {at:g} s leaves fewer than two saved states before the run ends at {t1:g} s "
             f"(a state saved every {h * every:g} s): take an earlier time")
 
     return units

@@ -190,9 +190,6 @@ def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...]
                                           f"port-Hamiltonian subsystem, and a vessel holds one")
         hull = overlay(base.to_dict(), {"vessel": over["vessel"]} if "vessel" in over else {})
         env_tables = _environment(data["environment"], path, base_dir, hull)
-        if "port_hamiltonian" in env_tables and ("port_hamiltonian" in over or "port_hamiltonian" in base.to_dict()):
-            raise _core.InvalidInputError(f"{path}: environment.waves.fluid_memory: the vessel already has a "
-                                          f"port-Hamiltonian subsystem, and a vessel holds one")
         if "port_hamiltonian" in env_tables and "added_mass" in (over.get("vessel") or {}):
             raise _core.InvalidInputError(f"{path}: environment.waves.fluid_memory sets the vessel's added mass to the "
                                           f"dataset's infinite-frequency added mass, and [vessel] gives added_mass "

@@ -311,11 +311,12 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
         raise _err(f"periods must be at least 1 (the fit window, in periods of the lowest frequency), got {periods:g}")
     # a regular wave steeper than 1/7 (height over length, deep water) breaks (Michell 1893;
     # DNV-RP-C205 §3.2.2): a larger amplitude is no wave linear theory describes
-    steep = 2 * amplitude * float(freqs.max()) ** 2 / (2 * math.pi * 9.81)
-    if steep > 1 / 7:
+    g = float(vessel.to_dict()["vessel"]["gravity"])
+    length = 2 * math.pi * g / float(freqs.max()) ** 2
+    if 2 * amplitude / length > 1 / 7:
         raise _err(f"amplitude = {amplitude:g} m makes the wave of {float(freqs.max()):g} rad/s steeper than it can be "
-                   f"(height/length {steep:.3g} > 1/7, where waves break): take amplitude <= "
-                   f"{9.81 * 2 * math.pi / float(freqs.max()) ** 2 / 14:.3g} m")
+                   f"(height/length {2 * amplitude / length:.3g} > 1/7, where waves break): take amplitude <= "
+                   f"{length / 14:.3g} m")
     shortest = 2 * math.pi / float(freqs.max())
     if h > shortest / 4:
         raise _err(f"h = {h:g} s cannot follow the wave of {float(freqs.max()):g} rad/s (period {shortest:.4g} s): "

@@ -218,7 +218,10 @@ impl Params {
             let at = e.span().map_or(String::new(), |r| {
                 let before = &text[..r.start.min(text.len())];
                 let line = before.matches('\n').count() + 1;
-                let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                let col = before[before.rfind('\n').map_or(0, |i| i + 1)..]
+                    .chars()
+                    .count()
+                    + 1;
                 format!(" (at line {line}, column {col})")
             });
             Error::Parse(format!("TOML syntax error: {}{at}", e.message().trim_end()))
@@ -473,18 +476,28 @@ impl Params {
 
     /// A required key is absent: a misspelling of it is named as such, else it is missing.
     pub fn missing(&self, section: &str, key: &str, unit: &str) -> Error {
-        if let Some(Value::Table(t)) = self.input.get(section) {
-            let want = [key.to_string()];
-            let taken = self.taken.get(section);
-            let read = |k: &String| taken.is_some_and(|t| t.iter().any(|x| x == k));
-            // A key another getter read is no misspelling of this one.
-            if let Some(typo) = t.keys().find(|k| !read(k) && nearest(k, &want).is_some()) {
-                let mut valid = self.taken.get(section).cloned().unwrap_or_default();
-                valid.retain(|k| k != typo);
-                return Error::Parse(unknown(typo, &valid, "field", &format!("[{section}]")));
-            }
-        }
-        missing(section, key, unit)
+        self.misspelling(section, key)
+            .unwrap_or_else(|| missing(section, key, unit))
+    }
+
+    /// The error naming a key of `[section]` that is a misspelling of `key`, if there is one
+    /// (a key another getter read is no misspelling of this one).
+    pub fn misspelling(&self, section: &str, key: &str) -> Option<Error> {
+        let Some(Value::Table(t)) = self.input.get(section) else {
+            return None;
+        };
+        let want = [key.to_string()];
+        let taken = self.taken.get(section);
+        let read = |k: &String| taken.is_some_and(|t| t.iter().any(|x| x == k));
+        let typo = t.keys().find(|k| !read(k) && nearest(k, &want).is_some())?;
+        let mut valid = taken.cloned().unwrap_or_default();
+        valid.retain(|k| k != typo);
+        Some(Error::Parse(unknown(
+            typo,
+            &valid,
+            "field",
+            &format!("[{section}]"),
+        )))
     }
 
     /// The normalised table of what was read, without the check for unread keys (for a

@@ -109,8 +109,9 @@ pub struct VesselSystem<'a> {
     own_linear_dim: usize,
     /// Each component with a flow of its own: its index and its range in [`VesselState::own`].
     own_flowing: Vec<(usize, std::ops::Range<usize>)>,
-    /// Where in [`VesselState::own`] the sensors' held measurements are ([`Frozen::held`]).
-    held: Option<std::ops::Range<usize>>,
+    /// The component holding sensors' measurements ([`Frozen::held`], sampled at the step ends)
+    /// and its range in [`VesselState::own`].
+    held_part: Option<(usize, std::ops::Range<usize>)>,
     /// The exact flow S2's balance beyond the structural one, per controller state and block
     /// system: computed once, at the upright attitude (`s2.rs`, `exact_balance`).
     exact_balance: std::sync::OnceLock<[[nalgebra::SVector<f64, 10>; 2]; 2]>,
@@ -146,6 +147,13 @@ impl<'a> VesselSystem<'a> {
             .find_map(|f| f.position_origin())
             .unwrap_or_else(Vector3::zeros);
         let linear = own::parts_of(vessel);
+        // The component whose own states hold the sensors' measurements, and its range.
+        let mut off = 0;
+        let held_part = vessel.forces.iter().enumerate().find_map(|(i, f)| {
+            off += f.own_states().len();
+            f.held_states()
+                .map(|_| (i, off - f.own_states().len()..off))
+        });
         Self {
             vessel,
             control_start,
@@ -169,9 +177,7 @@ impl<'a> VesselSystem<'a> {
             own_linear_dim: linear.iter().map(|p| p.1.len()).sum(),
             own_parts: linear,
             own_flowing: own::flowing_of(vessel),
-            held: vessel
-                .own_layout()
-                .find_map(|(f, r)| f.held_states().map(|h| r.start + h.start..r.start + h.end)),
+            held_part,
             exact_balance: Default::default(),
             s2_memo: Default::default(),
             accounts,
@@ -276,11 +282,18 @@ impl<'a> VesselSystem<'a> {
 
     /// The sensors' measurements held at `s` ([`Frozen::held`]).
     pub(super) fn held_of(&self, s: &VesselState) -> Option<[f64; super::forces::HELD]> {
-        self.held.as_ref().map(|r| {
-            let mut a = [0.0; super::forces::HELD];
-            a.copy_from_slice(&s.own[r.clone()]);
-            a
-        })
+        let (i, r) = self.held_part.as_ref()?;
+        let h = self.vessel.forces[*i].held_states()?;
+        let mut a = [0.0; super::forces::HELD];
+        a.copy_from_slice(&s.own[r.start + h.start..r.start + h.end]);
+        Some(a)
+    }
+
+    /// Component `i`'s update of its own states (range `r`) at time `t` ([`Force::own_end_step`]).
+    fn own_end_step(&self, i: usize, r: &std::ops::Range<usize>, t: f64, s: &mut VesselState) {
+        let mut x = s.own[r.clone()].to_vec();
+        self.vessel.forces[i].own_end_step(t, s, &mut x);
+        s.own[r.clone()].copy_from_slice(&x);
     }
 
     /// The frozen view at the attitude `q`, the vessel at rest.
@@ -495,12 +508,8 @@ impl Model for VesselSystem<'_> {
     /// state brings it (a run continued from an earlier call's last state).
     fn begin(&self, t0: f64, s: &mut VesselState) {
         // Sensors take their first samples where the run starts (a continued run keeps its own).
-        for (i, r, _) in &self.own_parts {
-            if self.vessel.forces[*i].held_states().is_some() {
-                let mut x = s.own[r.clone()].to_vec();
-                self.vessel.forces[*i].own_end_step(t0, s, &mut x);
-                s.own[r.clone()].copy_from_slice(&x);
-            }
+        if let Some((i, r)) = &self.held_part {
+            self.own_end_step(*i, r, t0, s);
         }
         if self.actuators > 0 && s.act.n != self.actuators {
             self.update_memory(s, self.control_on(t0), |f, fr, z, act| {
@@ -511,11 +520,8 @@ impl Model for VesselSystem<'_> {
     /// The components' own states' updates at the end of the step (a pipe's drift correction,
     /// the sensors' samples); rate-limited thrusters: record what they deliver.
     fn end_step(&self, t_step: f64, t1: f64, s: &mut VesselState) {
-        let parts = self.own_parts.iter().map(|(i, r, _)| (i, r));
-        for (i, r) in self.own_flowing.iter().map(|(i, r)| (i, r)).chain(parts) {
-            let mut x = s.own[r.clone()].to_vec();
-            self.vessel.forces[*i].own_end_step(t1, s, &mut x);
-            s.own[r.clone()].copy_from_slice(&x);
+        for (i, r) in self.own_flowing.iter().chain(&self.held_part) {
+            self.own_end_step(*i, r, t1, s);
         }
         if self.actuators > 0 {
             self.update_memory(s, self.control_on(t_step), |f, fr, z, act| {

@@ -235,14 +235,7 @@ pub fn read(p: &mut Params, body: &Body, g: &Gains) -> crate::Result<Observer> {
     let k3 = opt("bias_gain", "N/(m s), N/(m s), N m/(rad s)")?;
     let idx = [0, 1, 5];
     let m = Matrix3::from_fn(|i, j| body.mass_matrix[(idx[i], idx[j])]);
-    let (k4, k3) =
-        gains(k4, k3, omega_b, omega_c, &m, &damping).map_err(|e| match (e, given_b) {
-            (Error::InvalidInput(msg), None) => Error::InvalidInput(msg.replace(
-                "bias_bandwidth = ",
-                "bias_bandwidth (not given: wave_frequency / 5) = ",
-            )),
-            (e, _) => e,
-        })?;
+    let (k4, k3) = gains(k4, k3, omega_b, given_b.is_some(), omega_c, &m, &damping)?;
     for i in 0..3 {
         let r = k3[i] / k4[i];
         if !(r > 1.0 / bias_time && r < omega0) {

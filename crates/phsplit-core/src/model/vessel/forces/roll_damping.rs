@@ -76,11 +76,11 @@ pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn
         }
         // Neither: a misspelling of one is named as such (else the table says what it needs).
         (None, None) if quadratic == 0.0 => {
-            for key in ["linear", "critical_fraction"] {
-                let e = p.missing(T, key, "");
-                if e.to_string().contains("unknown field") {
-                    return Err(e);
-                }
+            if let Some(e) = ["linear", "critical_fraction"]
+                .into_iter()
+                .find_map(|key| p.misspelling(T, key))
+            {
+                return Err(e);
             }
             0.0
         }

@@ -59,6 +59,10 @@ const POSITION_BIAS: Physical = Physical {
     hi_closed: true,
     why: "a position bias beyond 1 km is no DP sensor's",
 };
+const HEADING_NOISE: Physical = Physical {
+    lo: 0.0,
+    ..HEADING_ERROR
+};
 const HEADING_ERROR: Physical = Physical {
     lo: -0.5,
     hi: 0.5,
@@ -78,9 +82,16 @@ impl Sensor {
     fn out_at(&self, t: f64) -> bool {
         self.dropout.iter().any(|&(a, b)| t >= a && t < b)
     }
-    /// The index of the last sample instant at or before `t`.
-    fn index(&self, t: f64) -> f64 {
-        (t * self.rate + 1e-9).floor()
+    /// At time `t`, with its last sample's index `last` and validity `valid` (1 or 0): the
+    /// index of the sample due now, if one is (a new instant passed, or back from a dropout),
+    /// and whether it delivers.
+    fn due(&self, t: f64, last: f64, valid: f64) -> (Option<f64>, bool) {
+        let k = (t * self.rate + 1e-9).floor();
+        let delivers = !self.out_at(t);
+        (
+            (delivers && (k != last || valid == 0.0)).then_some(k),
+            delivers,
+        )
     }
 }
 
@@ -149,13 +160,8 @@ pub fn read(p: &mut Params) -> crate::Result<Option<Sensors>> {
         .opt_f64(T, "gnss_noise", "m", Range::Physical(&POSITION_NOISE))?
         .unwrap_or(0.0);
     let gyro_noise = p
-        .opt_f64(T, "gyro_noise", "rad", Range::Physical(&HEADING_ERROR))?
+        .opt_f64(T, "gyro_noise", "rad", Range::Physical(&HEADING_NOISE))?
         .unwrap_or(0.0);
-    if gyro_noise < 0.0 {
-        return Err(Error::InvalidInput(format!(
-            "sensors.gyro_noise must be ≥ 0 (rad, a standard deviation), got {gyro_noise}"
-        )));
-    }
     let gyro_bias = p
         .opt_f64(T, "gyro_bias", "rad", Range::Physical(&HEADING_ERROR))?
         .unwrap_or(0.0);
@@ -270,21 +276,19 @@ impl Sensors {
     /// At time `t`, with the vessel at position `pos` and heading `psi`: take the samples due
     /// and mark the sensors out or in (module documentation).
     pub fn update(&self, t: f64, pos: &Vector3<f64>, psi: f64, x: &mut [f64]) {
-        let out = self.gnss.out_at(t);
-        let k = self.gnss.index(t);
-        if !out && (k != x[K_GNSS] || x[VALID_GNSS] == 0.0) {
+        let (k, delivers) = self.gnss.due(t, x[K_GNSS], x[VALID_GNSS]);
+        if let Some(k) = k {
             x[0] = pos.x + self.gnss_bias[0] + self.gnss_noise * normal(self.seed, 1, k);
             x[1] = pos.y + self.gnss_bias[1] + self.gnss_noise * normal(self.seed, 2, k);
             x[K_GNSS] = k;
         }
-        x[VALID_GNSS] = if out { 0.0 } else { 1.0 };
-        let out = self.gyro.out_at(t);
-        let k = self.gyro.index(t);
-        if !out && (k != x[K_GYRO] || x[VALID_GYRO] == 0.0) {
+        x[VALID_GNSS] = f64::from(u8::from(delivers));
+        let (k, delivers) = self.gyro.due(t, x[K_GYRO], x[VALID_GYRO]);
+        if let Some(k) = k {
             x[2] = psi + self.gyro_bias + self.gyro_noise * normal(self.seed, 3, k);
             x[K_GYRO] = k;
         }
-        x[VALID_GYRO] = if out { 0.0 } else { 1.0 };
+        x[VALID_GYRO] = f64::from(u8::from(delivers));
     }
 }
 

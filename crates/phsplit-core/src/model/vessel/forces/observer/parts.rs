@@ -7,13 +7,15 @@ use super::N;
 use crate::error::Error;
 use nalgebra::{Matrix3, Vector3};
 
-/// K₄ and K₃ as given, or placed (the same in x and y, below): the low-frequency error dynamics of each degree of freedom
-/// (below the wave filter, `η̃ ≈ R ν̃ / K₂`) are `M s² + (D + K₄/K₂) s + K₃/K₂ = 0`; critically
-/// damped at ω_b they need `K₃ = K₂ M ω_b²`, `K₄ = K₂ (2 M ω_b − D)`.
+/// K₄ and K₃ as given, or placed (the same in x and y, below): the low-frequency error
+/// dynamics of each degree of freedom (below the wave filter, `η̃ ≈ R ν̃ / K₂`) are
+/// `M s² + (D + K₄/K₂) s + K₃/K₂ = 0`; critically damped at ω_b they need `K₃ = K₂ M ω_b²`,
+/// `K₄ = K₂ (2 M ω_b − D)`. `given_b`: ω_b was given (else it is the default ω₀/5).
 pub(super) fn gains(
     k4: Option<Vector3<f64>>,
     k3: Option<Vector3<f64>>,
     omega_b: f64,
+    given_b: bool,
     k2: f64,
     m: &Matrix3<f64>,
     damping: &Vector3<f64>,
@@ -28,8 +30,9 @@ pub(super) fn gains(
         let excess = 2.0 * mi * omega_b - damping[i];
         if excess <= 0.0 {
             return Err(Error::InvalidInput(format!(
-                "observer: in {dof} the model damping ({:.4e}) alone exceeds the critical damping of the bias estimate at bias_bandwidth = {omega_b} rad/s ({:.4e}): raise bias_bandwidth, or give velocity_gain and bias_gain",
+                "observer: in {dof} the model damping ({:.4e}) alone exceeds the critical damping of the bias estimate at bias_bandwidth {}= {omega_b} rad/s ({:.4e}): raise bias_bandwidth, or give velocity_gain and bias_gain",
                 damping[i],
+                if given_b { "" } else { "(not given: wave_frequency / 5) " },
                 2.0 * mi * omega_b
             )));
         }
