@@ -57,6 +57,8 @@ def _json_tables() -> str:
 
 def render() -> str:
     return "\n".join([
+        "## Time to accuracy on the users' workloads\n",
+        _markdown(RESULTS / "workloads.md", 3),
         "## Work per step, work-precision, stability and memory: the paper's scheme\n",
         _markdown(RESULTS / "summary.md", 3),
         "## The same with the default projection\n",

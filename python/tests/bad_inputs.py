@@ -1596,3 +1596,40 @@ CATALOGUE += [
                  'fluid_memory = true\n'.replace("'", '"')), E,
         ("fluid_memory", "already has a port-Hamiltonian subsystem")),
 ]
+
+
+def _fmu_export_adaptive():
+    from phsplit import fmu
+    from phsplit.scenario import Scenario
+
+    with tempfile.TemporaryDirectory() as d:
+        fmu.export(Scenario(phsplit.Vessel.paper(), phsplit.Settings(rtol=1e-4)), os.path.join(d, "a.fmu"))
+
+
+CATALOGUE += [
+    Bad("adaptive rtol of zero", sim(rtol=0.0), E, ("rtol", "(0, 1]")),
+    Bad("adaptive rtol above one", sim(rtol=2.0), E, ("rtol", "(0, 1]")),
+    Bad("adaptive rtol below round-off", sim(rtol=1e-16), E, ("rtol", "1e-13")),
+    Bad("negative adaptive atol", sim(atol=-1e-3), E, ("atol", "(0, 1e3]")),
+    Bad("infinite adaptive atol", sim(atol=float("inf")), E, ("atol",)),
+    Bad("h_max without a tolerance", sim(h_max=5.0), E, ("h_max", "rtol or atol")),
+    Bad("zero h_max", sim(atol=1e-3, h_max=0.0), E, ("h_max", "> 0")),
+    Bad("adaptive steps with Runge-Kutta", sim(method="rk4", atol=1e-3), E, ("rk4", "splitting methods")),
+    Bad("adaptive steps with events",
+        lambda: phsplit.simulate(phsplit.Vessel.paper(), (0.0, 10.0), 0.5, atol=1e-3,
+                                 events=[phsplit.events.watch_circle(1e4)]), E, ("events", "fixed step")),
+    Bad("adaptive save_at outside the span", sim(atol=1e-3, save_at=[5.0, 20.0]), E, ("save_at",)),
+    Bad("adaptive settings given twice",
+        lambda: phsplit.simulate(phsplit.Vessel.paper(), settings=phsplit.Settings(t_span=(0.0, 5.0)), atol=1e-3), E,
+        ("rtol, atol and h_max", "Settings")),
+    Bad("simulate_many with adaptive steps",
+        lambda: phsplit.simulate_many([{"vessel.mass": 6e6}], settings=phsplit.Settings(t_span=(0.0, 5.0), atol=1e-3)),
+        E, ("simulate_many", "time grid", "rtol and atol")),
+    Bad("sweep file with adaptive steps", _load_sweep_text(
+        b'[simulation]\nh = 1.0\nt_span = [0.0, 2.0]\natol = 1e-3\n[sweep]\n' + _MASS_GRID), P,
+        ("a sweep", "time grid")),
+    Bad("scenario rtol as text", scenario('[simulation]\nrtol = "tight"\n'), P, ("simulation.rtol", "number")),
+    Bad("FMU export of an adaptive scenario", _fmu_export_adaptive, E, ("FMU", "fixed internal step", "rtol")),
+    Bad("CLI: scenario with a zero rtol", cli(*SIM, "s.toml", files={
+        "s.toml": b'[simulation]\nt_span = [0.0, 2.0]\nrtol = 0.0\n'}), C, ("rtol", "(0, 1]")),
+]

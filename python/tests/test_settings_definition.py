@@ -14,6 +14,9 @@ from phsplit import _core, fmu
 #: Settings that name the run or its saving, not how a step is taken: not FMU parameters (the
 #: master's communication steps and its own files take their place).
 NOT_IN_AN_FMU = {"t_span", "save_every", "name"}
+#: Adaptive steps: the FMU takes its fixed internal step within each communication step, and
+#: exporting a scenario with a tolerance is refused (``phsplit.fmu.export``).
+NOT_IN_AN_FMU |= {"rtol", "atol", "h_max"}
 
 
 def core_keys() -> set[str]:

@@ -20,6 +20,7 @@ fn thousand_steps(ledger: bool) -> Options {
         save_every: 1000,
         outer: Outer::Dissipative,
         ledger,
+        tolerance: None,
     }
 }
 

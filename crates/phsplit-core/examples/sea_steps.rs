@@ -27,6 +27,7 @@ fn main() {
         save_every: n,
         outer: Outer::Dissipative,
         ledger: true,
+        tolerance: None,
     };
     let t = std::time::Instant::now();
     let tr = run(&sys, &method, black_box(y0), &opts).unwrap();

@@ -36,6 +36,7 @@ fn main() {
         save_every: 1000,
         outer: Outer::Dissipative,
         ledger: true,
+        tolerance: None,
     };
     let t = std::time::Instant::now();
     let mut e = 0.0;

@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::methods::{Method, Outer};
 use crate::model::vessel::params::unknown;
 use crate::model::vessel::LinearFlow;
-use crate::solve::{Options, MAX_STEPS};
+use crate::solve::{Options, Tolerance, MAX_STEPS};
 use toml::{Table, Value};
 
 /// The settings of a run.
@@ -27,6 +27,12 @@ pub struct Settings {
     /// Project after every step onto the invariants of the exact flow that the split does not
     /// keep (the restoring invariant; docs/model.md §3.6). Energy-neutral.
     pub project_invariants: bool,
+    /// Adaptive steps (`solve/adaptive.rs`): relative and absolute tolerance and the longest
+    /// step (s). With neither tolerance the steps are fixed; with one, the other takes
+    /// `solve_ivp`'s default (1e-3, 1e-6).
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+    pub h_max: Option<f64>,
 }
 
 impl Default for Settings {
@@ -46,12 +52,15 @@ impl Default for Settings {
             linear_flow: LinearFlow::Gauss,
             ledger: true,
             project_invariants: true,
+            rtol: None,
+            atol: None,
+            h_max: None,
         }
     }
 }
 
 /// The keys of a `[simulation]` table, with what each takes.
-pub const KEYS: [(&str, &str); 10] = [
+pub const KEYS: [(&str, &str); 13] = [
     ("t_span", "two numbers [t0, t1], s"),
     ("h", "step size, s"),
     ("method", "a method name"),
@@ -64,6 +73,12 @@ pub const KEYS: [(&str, &str); 10] = [
     ("linear_flow", "'exact' or 'gauss'"),
     ("ledger", "true or false"),
     ("project_invariants", "true or false"),
+    ("rtol", "relative tolerance of adaptive steps, in (0, 1]"),
+    (
+        "atol",
+        "absolute tolerance of adaptive steps (m, rad, m/s, rad/s), in (0, 1e3]",
+    ),
+    ("h_max", "longest adaptive step, s"),
     ("name", "a label for the output files"),
 ];
 
@@ -166,6 +181,9 @@ impl Settings {
                         ))
                     })?
                 }
+                "rtol" => s.rtol = Some(number(key, v)?),
+                "atol" => s.atol = Some(number(key, v)?),
+                "h_max" => s.h_max = Some(number(key, v)?),
                 "name" => name = Some(check_name(string(key, v)?)?),
                 other => {
                     return Err(Error::Parse(unknown(
@@ -208,6 +226,16 @@ impl Settings {
             ));
         }
         let (n, last_h) = self.steps()?;
+        let tolerance = self.tolerance()?;
+        if let Some(tol) = &tolerance {
+            tol.validate(t0)?;
+            if matches!(self.method, Method::RungeKutta(_)) {
+                return Err(Error::InvalidInput(format!(
+                    "adaptive steps (rtol, atol) are for the splitting methods (lie, sp2, mcl2, sp4, sp6); {} runs with a fixed step here: drop rtol and atol, or choose a splitting method",
+                    self.method.name()
+                )));
+            }
+        }
         Options {
             t0: self.t_span.0,
             h: self.h,
@@ -216,8 +244,32 @@ impl Settings {
             save_every: self.save_every,
             outer: self.outer,
             ledger: self.ledger,
+            tolerance,
         }
         .validate()
+    }
+    /// The adaptive run's tolerance, if `rtol` or `atol` is given.
+    pub fn tolerance(&self) -> Result<Option<Tolerance>> {
+        if self.rtol.is_none() && self.atol.is_none() {
+            if let Some(hm) = self.h_max {
+                return Err(Error::InvalidInput(format!(
+                    "h_max = {hm} s bounds adaptive steps only: give rtol or atol as well, or drop h_max (fixed steps take h)"
+                )));
+            }
+            return Ok(None);
+        }
+        let (t0, t1) = self.t_span;
+        Ok(Some(Tolerance {
+            rtol: self.rtol.unwrap_or(1e-3),
+            atol: self.atol.unwrap_or(1e-6),
+            h_max: self.h_max.unwrap_or(t1 - t0),
+            t1,
+            save_at: Vec::new(),
+        }))
+    }
+    /// Whether the steps are adaptive.
+    pub fn adaptive(&self) -> bool {
+        self.rtol.is_some() || self.atol.is_some()
     }
 
     /// The number of steps: whole steps of `h`, and a last shorter one when the span is not a
@@ -268,6 +320,7 @@ impl Settings {
             save_every: self.save_every,
             outer: self.outer,
             ledger: self.ledger,
+            tolerance: self.tolerance()?,
         };
         o.validate()?;
         Ok(o)

@@ -397,6 +397,7 @@ impl Instance {
             save_every: n_steps,
             outer: r.settings.outer,
             ledger: r.settings.ledger,
+            tolerance: None,
         };
         if let Err(e) = opts.validate() {
             return Err(format!(

@@ -274,6 +274,9 @@ pub(crate) fn settings_dict<'py>(
     d.set_item("linear_flow", s.linear_flow.name())?;
     d.set_item("ledger", s.ledger)?;
     d.set_item("project_invariants", s.project_invariants)?;
+    d.set_item("rtol", s.rtol)?;
+    d.set_item("atol", s.atol)?;
+    d.set_item("h_max", s.h_max)?;
     let steps = s.steps().ok();
     d.set_item("n_steps", steps.map(|x| x.0))?;
     d.set_item("last_h", steps.map(|x| x.1))?;

@@ -21,12 +21,18 @@ struct PyMonitor {
     progress: Option<Py<PyAny>>,
     n_steps: usize,
     last: std::time::Instant,
+    next_check: usize,
     error: Option<PyErr>,
 }
 
 impl Monitor for PyMonitor {
     fn keep_going(&mut self, done: usize) -> bool {
-        if done % 256 != 0 || self.last.elapsed().as_secs_f64() < 0.1 {
+        // `done` grows by one a step, or (adaptive steps) by the nominal steps of h covered.
+        if done < self.next_check {
+            return true;
+        }
+        self.next_check = done + 256;
+        if self.last.elapsed().as_secs_f64() < 0.1 {
             return true;
         }
         self.last = std::time::Instant::now();
@@ -52,7 +58,7 @@ impl Monitor for PyMonitor {
 /// released while integrating; signals are checked about every 0.1 s, and Ctrl-C returns what
 /// was computed with status "interrupted". `progress(steps_done, n_steps)` is called as often.
 #[pyfunction]
-#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None, extrema=false, continuing=false))]
+#[pyo3(signature = (vessel, settings, state0=None, orthonormalize=false, progress=None, extrema=false, continuing=false, save_at=None))]
 fn integrate<'py>(
     py: Python<'py>,
     vessel: &PyVessel,
@@ -62,9 +68,20 @@ fn integrate<'py>(
     progress: Option<Py<PyAny>>,
     extrema: bool,
     continuing: bool,
+    save_at: Option<PyReadonlyArray1<'_, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (settings, _) = settings_of(settings, true)?;
-    let opts = settings.options().map_err(to_py)?;
+    let mut opts = settings.options().map_err(to_py)?;
+    // Output times of an adaptive run: its steps land on them (fixed steps: phsplit.events).
+    if let Some(ts) = &save_at {
+        let Some(tol) = opts.tolerance.as_mut() else {
+            return Err(InvalidInputError::new_err(
+                "save_at is taken by the core only with adaptive steps (rtol, atol)",
+            ));
+        };
+        tol.save_at = entries(ts);
+        tol.validate(opts.t0).map_err(to_py)?;
+    }
     let y0 = match &state0 {
         None => vessel.inner.initial_state(),
         Some(a) if continuing => vessel.inner.continuing_state(&entries(a)).map_err(to_py)?,
@@ -83,6 +100,7 @@ fn integrate<'py>(
         progress,
         n_steps: opts.n_steps,
         last: std::time::Instant::now(),
+        next_check: 256,
         error: None,
     };
     let mon = &mut monitor;
@@ -211,6 +229,7 @@ fn integrate<'py>(
     }
     d.set_item("outputs", reported)?;
     d.set_item("steps", traj.steps)?;
+    d.set_item("rejected", traj.rejected)?;
     // A state that continues the run: the 27 numbers, the components' own states, then the
     // memory of rate-limited thrusters (none for other vessels).
     d.set_item(
@@ -317,8 +336,9 @@ impl PyVectorField {
     /// classical peer of the work-precision study. The controller switch at `control_start` is
     /// a segment boundary. Returns `(y_end, function_evaluations, accepted_steps)`; a solver
     /// error, or more than 10^7 steps in a segment, raises IntegrationError. Only the end point
-    /// is stored; the run is not interruptible (keep it short).
-    #[pyo3(signature = (t_span, y0, rtol, atol))]
+    /// is stored, or the states at `t_eval` (increasing times within `t_span`, by the method's
+    /// dense output) as a flat array of rows; the run is not interruptible (keep it short).
+    #[pyo3(signature = (t_span, y0, rtol, atol, t_eval=None))]
     fn solve_dop853<'py>(
         &self,
         py: Python<'py>,
@@ -326,7 +346,9 @@ impl PyVectorField {
         y0: PyReadonlyArray1<'_, f64>,
         rtol: f64,
         atol: PyReadonlyArray1<'_, f64>,
+        t_eval: Option<PyReadonlyArray1<'_, f64>>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, usize, usize)> {
+        let t_eval: Vec<f64> = t_eval.map(|a| entries(&a)).unwrap_or_default();
         use differential_equations::prelude::*;
         let y = entries(&y0);
         let a = entries(&atol);
@@ -353,6 +375,12 @@ impl PyVectorField {
             return Err(InvalidInputError::new_err(format!(
                 "t_span must be finite with t1 > t0, got ({t0}, {t1})"
             )));
+        }
+        if t_eval.iter().any(|t| !(*t > t0 && *t <= t1)) || t_eval.windows(2).any(|w| w[1] <= w[0])
+        {
+            return Err(InvalidInputError::new_err(
+                "t_eval must be increasing times in (t0, t1]",
+            ));
         }
         struct Segment<'a> {
             sys: VesselSystem<'a>,
@@ -389,6 +417,7 @@ impl PyVectorField {
             }
             cuts.push(t1);
             let (mut nfev, mut steps) = (0usize, 0usize);
+            let mut rows: Vec<f64> = Vec::with_capacity(t_eval.len() * STATE_DIM);
             for w in cuts.windows(2) {
                 let seg = Segment {
                     sys: sys.clone(),
@@ -398,20 +427,35 @@ impl PyVectorField {
                     .rtol(rtol)
                     .atol(atol_v.clone())
                     .max_steps(MAX_DOP853_STEPS);
-                // Only the end point is kept (the default output stores every step).
+                // Only the end point is kept (the default output stores every step), or the
+                // segment's asked times and its end.
+                let mut times: Vec<f64> = t_eval
+                    .iter()
+                    .copied()
+                    .filter(|t| *t > w[0] && *t < w[1])
+                    .collect();
+                times.push(w[1]);
                 let sol = IVP::ode(&seg, w[0], w[1], state)
                     .method(method)
-                    .t_eval([w[1]])
+                    .t_eval(times.clone())
                     .solve()
                     .map_err(|e| format!("{e:?}"))?;
                 state = *sol.y.last().ok_or("no output")?;
+                for (t, y) in sol.t.iter().zip(&sol.y) {
+                    if t_eval.contains(t) {
+                        rows.extend_from_slice(y.as_slice());
+                    }
+                }
                 nfev += sol.evals.function;
                 steps += sol.steps.accepted;
             }
-            Ok::<_, String>((state, nfev, steps))
+            if !t_eval.is_empty() {
+                return Ok::<_, String>((rows, nfev, steps));
+            }
+            Ok::<_, String>((state.as_slice().to_vec(), nfev, steps))
         });
         let (y1, nfev, steps) = out.map_err(crate::IntegrationError::new_err)?;
-        Ok((PyArray1::from_slice(py, y1.as_slice()), nfev, steps))
+        Ok((PyArray1::from_vec(py, y1), nfev, steps))
     }
 }
 

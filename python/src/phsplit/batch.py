@@ -54,6 +54,10 @@ _SHAPES = ("a parameter path is 'table.name', 'table.name[i]', 'table.name[i][j]
            "'table.list[i].name' (a table of a list, like thrusters.unit[0].max_thrust)")
 
 
+_ADAPTIVE_REFUSED = ("the cases of {what} share one time grid (dims case, time), which adaptive steps (rtol, atol) "
+                     "do not give: drop rtol and atol for {what}, or run the cases one by one with phsplit.simulate")
+
+
 def _resolve(d: dict, key: str) -> list[str | int]:
     """Check a parameter path against a vessel's dict: the keys and indices that lead to its
     number (the last key of a table in a list may be new: the vessel file's reader checks it)."""
@@ -188,6 +192,8 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
     settings = settings or Settings(**kw)
     if not isinstance(settings, Settings):
         raise _core.InvalidInputError(f"settings must be a phsplit.Settings, got {type(settings).__name__}")
+    if settings.adaptive:
+        raise _core.InvalidInputError(_ADAPTIVE_REFUSED.format(what="simulate_many"))
     if isinstance(cases, (str, bytes, Mapping)) or not isinstance(cases, Sequence) or not all(
             isinstance(c, Mapping) for c in cases):
         raise _core.InvalidInputError("cases must be a sequence of mappings {parameter path: value}, "
@@ -305,6 +311,8 @@ def load_sweep(path: str) -> Sweep:
     # the rest is a scenario
     sc = scn.from_dict(data, path)
     settings = sc.settings
+    if settings.adaptive:
+        raise _core.ScenarioParseError(f"{path}: " + _ADAPTIVE_REFUSED.format(what="a sweep"))
     params = sw.get("parameters", {})
     if not isinstance(params, dict) or not params:
         raise _core.ScenarioParseError(f"{path}: [sweep.parameters] must list at least one parameter")

@@ -107,6 +107,9 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--linear-flow", choices=["exact", "gauss"],
                    help="flow S2 by Gauss collocation (the library's default) or exactly (matrix "
                    "exponentials, the paper's; the default of the Fig. 2 scenario)")
+    s.add_argument("--rtol", type=float, help="adaptive steps to this relative tolerance (--h: the first step)")
+    s.add_argument("--atol", type=float, help="adaptive steps to this absolute tolerance (m, rad, m/s, rad/s)")
+    s.add_argument("--h-max", type=float, help="longest adaptive step, s")
     s.add_argument("--no-plot", action="store_true", help="skip the PNG")
     sub.add_parser("methods", help="list the integration methods")
     sub.add_parser("vessels", help="list the shipped vessels (phsplit.Vessel.preset) and their sources")
@@ -307,6 +310,9 @@ def _override_suffix(args) -> str:
         parts.append(f"s{args.save_every}")
     if args.linear_flow is not None:
         parts.append(args.linear_flow)
+    for flag in ("rtol", "atol", "h_max"):
+        if getattr(args, flag, None) is not None:
+            parts.append(f"{flag.replace('_', '')}{num(getattr(args, flag))}")
     if args.control_start is not None:
         parts.append(f"c{args.control_start}")
     # Only the characters a scenario name may hold (the values were validated before this).
@@ -389,6 +395,9 @@ def _simulate(args) -> int:
         over["save_every"] = args.save_every
     if args.linear_flow is not None:
         over["linear_flow"] = args.linear_flow
+    for flag in ("rtol", "atol", "h_max"):
+        if getattr(args, flag, None) is not None:
+            over[flag] = getattr(args, flag)
     if args.control_start is not None:
         if args.control_start == "never":
             over["control_start"] = None
@@ -440,7 +449,8 @@ def _simulate(args) -> int:
 
     bar = _progress_bar(n)
     try:
-        chunks = _chunks(n, sc.save_every)
+        # Adaptive steps run as one call: a cut would restart the step-size controller.
+        chunks = [n] if sc.settings.adaptive else _chunks(n, sc.save_every)
         text = None
         if args.scenario:
             with open(args.scenario, "rb") as f:

@@ -309,6 +309,10 @@ def export(scenario: Any = None, out: str | os.PathLike[str] = "vessel.fmu", *,
             f"or None for the paper's Fig. 2; got {type(scenario).__name__} (a Vessel goes in as "
             f"phsplit.scenario.Scenario(vessel, settings))")
     st = s.settings
+    if st.adaptive:
+        raise _core.InvalidInputError(
+            "the FMU steps with its fixed internal step h within each communication step; the scenario asks for "
+            "adaptive steps (rtol, atol): drop rtol and atol (and h_max) from its [simulation] to export it")
     sim = {"method": st.method, "h": float(st.h), "linear_flow": st.linear_flow, "outer": st.outer,
            "project_invariants": bool(st.project_invariants),
            "control_start": "never" if st.control_start is None else float(st.control_start)}

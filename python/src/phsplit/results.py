@@ -91,13 +91,19 @@ def settings_of(ds) -> Settings:
     pi = sim.get("project_invariants", True)
     if not isinstance(pi, bool):
         raise _damaged("phsplit_settings", f"simulation.project_invariants = {pi!r} is not true or false")
+    tol = {}
+    for k in ("rtol", "atol", "h_max"):
+        v = sim.get(k)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))):
+            raise _damaged("phsplit_settings", f"simulation.{k} = {v!r} is not a number")
+        tol[k] = v
     ts = sim["t_span"]
     if len(ts) != 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in ts):
         raise _damaged("phsplit_settings", f"simulation.t_span = {ts!r} is not two numbers")
     settings = Settings(t_span=(float(ts[0]), float(ts[1])), h=sim["h"], method=sim["method"],
                         control_start=None if cs == "never" else cs, outer=sim["outer"],
                         save_every=sim["save_every"], linear_flow=sim["linear_flow"], ledger=sim["ledger"],
-                        project_invariants=pi)
+                        project_invariants=pi, **tol)
     try:
         settings.checked()
     except _core.InvalidInputError as e:
@@ -162,6 +168,10 @@ def rerun(source, progress: bool = False):
     :func:`sweep_case` first."""
     ds = open_dataset(source) if isinstance(source, (str, os.PathLike)) else source
     vessel, settings, y0, chunks = check_record(ds)
+    if ds.attrs.get("status") == "interrupted" and settings.adaptive:
+        raise _core.InvalidInputError(
+            "the file records an interrupted run with adaptive steps (rtol, atol): its steps depend on where the run "
+            "ends, so it cannot be rerun to the step it reached; rerun the whole run from its scenario")
     if ds.attrs.get("status") == "interrupted":
         left, cut = int(ds.attrs["steps"]), []
         for c in chunks:

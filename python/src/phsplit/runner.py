@@ -80,7 +80,10 @@ def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray, st
 def _warn_if_step_too_long(vessel: Vessel, y0: np.ndarray | None, settings: Settings, stacklevel: int) -> None:
     """A StepSizeWarning when h exceeds half the shortest natural period of the
     vessel (flow S2 linearised at the initial attitude, with the controller as it will act):
-    fewer than two steps per period cannot represent that oscillation."""
+    fewer than two steps per period cannot represent that oscillation. Not for adaptive steps:
+    ``h`` is then only the first step tried, and the error control chooses the rest."""
+    if settings.adaptive:
+        return
     try:
         h = float(settings.h)
         if not (math.isfinite(h) and h > 0.0):
@@ -120,15 +123,16 @@ _COLUMNS = ("t", "x", "euler", "quaternion", "Q", "p", "m", "mu", "phi_th", "phi
 
 
 def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, orthonormalize: bool = False,
-        callback=None, running_max: bool = False, continuing: bool = False, stacklevel: int = 4) -> Solution:
+        callback=None, running_max: bool = False, continuing: bool = False, stacklevel: int = 4,
+        save_at: np.ndarray | None = None) -> Solution:
     """One core call: ``vessel`` integrated with ``settings`` from ``y0`` (the vessel's initial
     state when None). ``continuing``: ``y0`` is the last state of an earlier call of the same
     run (chunks, ``save_at``, events, ``Solution.at``), taken as it is, only checked to be finite.
     ``callback(steps_done, n_steps)`` is called as the core goes. ``stacklevel`` places the
-    warnings at the user's call."""
+    warnings at the user's call. ``save_at``: output times an adaptive run lands on."""
     _warn_if_step_too_long(vessel, y0, settings, stacklevel)
     raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), callback, bool(running_max),
-                          bool(continuing and y0 is not None))
+                          bool(continuing and y0 is not None), save_at)
     used = raw["settings"]
     e = raw["energy"]
     info = _core.method_info(used["method"])
@@ -147,6 +151,7 @@ def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, ort
         status=raw["status"], method=info["name"], h=used["h"], control_start=used["control_start"],
         steps=raw["steps"], failure=raw.get("failure"), last_good_state=raw["last_good"],
         meta={"mass": mass, "inertia": inertia, "mass_matrix": vessel.mass_matrix, "s2_solver": raw["s2_solver"],
+              "rejected": int(raw["rejected"]),
               "t_last_good": raw["t_last_good"], "components": vessel.components},
         settings=dict(used),
         outputs={k: (u, ln, np.asarray(v)) for k, (u, ln, v) in raw.get("outputs", {}).items()},

@@ -13,6 +13,10 @@ from . import _core, _provided
 _DEFAULTS = _core.default_settings()
 
 
+#: Settings whose ``None`` means "not given" (fixed steps).
+_OPTIONAL = ("rtol", "atol", "h_max")
+
+
 @dataclass(frozen=True)
 class Settings:
     """The settings of a run, with the one set of defaults (the core's; the paper's Fig. 2:
@@ -30,6 +34,16 @@ class Settings:
     linear_flow: str = _DEFAULTS["linear_flow"]
     ledger: bool = _DEFAULTS["ledger"]
     project_invariants: bool = _DEFAULTS["project_invariants"]
+    #: Adaptive steps (docs/how-to/choose-method-step-flow.md): with ``rtol`` or ``atol`` the
+    #: steps follow the error estimate and ``h`` is the first one tried; ``None``: fixed steps.
+    rtol: float | None = _DEFAULTS["rtol"]
+    atol: float | None = _DEFAULTS["atol"]
+    h_max: float | None = _DEFAULTS["h_max"]
+
+    @property
+    def adaptive(self) -> bool:
+        """Whether the steps are adaptive (``rtol`` or ``atol`` given)."""
+        return self.rtol is not None or self.atol is not None
 
     def as_core(self) -> dict[str, Any]:
         """The settings as the core takes them: numpy scalars as Python numbers, ``None`` for
@@ -37,6 +51,9 @@ class Settings:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
         if d["control_start"] is None:
             d["control_start"] = "never"
+        for k in _OPTIONAL:
+            if d[k] is None:
+                del d[k]
         for k, v in d.items():
             if v is None:
                 what = dict(_core.settings_keys())
@@ -64,4 +81,7 @@ def settings_to_toml(settings: Mapping[str, Any]) -> str:
     sim["t_span"] = [float(x) for x in sim["t_span"]]
     if sim.get("control_start") is None:
         sim["control_start"] = "never"
+    for k in _OPTIONAL:
+        if sim.get(k) is None:
+            sim.pop(k, None)
     return _core.dumps_toml({"simulation": sim})

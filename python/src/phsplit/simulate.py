@@ -37,6 +37,9 @@ def simulate(
     project_invariants: bool = Settings.project_invariants,
     initial: np.ndarray | Mapping[str, Sequence[float]] | None = None,
     linear_flow: str = Settings.linear_flow,
+    rtol: float | None = None,
+    atol: float | None = None,
+    h_max: float | None = None,
     orthonormalize: bool = False,
     settings: Settings | None = None,
     progress: bool | Any = None,
@@ -45,7 +48,8 @@ def simulate(
     running_max: bool = False,
     _continuing: bool = False,
 ) -> Solution:
-    """Simulate the vessel with fixed steps ``h`` over ``t_span``.
+    """Simulate the vessel over ``t_span`` with fixed steps ``h``, or adaptive steps to a
+    tolerance (``rtol``, ``atol``; ``h`` is then the first step tried, ``h_max`` the longest).
 
     ``method`` is one of ``phsplit.METHODS``: splitting ``lie``, ``sp2`` (Strang), ``sp4``,
     ``sp6`` (Blanes–Moan) or explicit Runge–Kutta ``euler``, ``heun``, ``rk4``. The controller
@@ -85,6 +89,15 @@ def simulate(
     "event"``), and every one found is in ``Solution.events``. ``running_max=True`` keeps the
     largest controller force and moment over every step, saved or not
     (``Solution.meta["running_max"]``: name → (value, time)).
+
+    Adaptive steps (splitting methods): each step is taken whole and as two halves, the
+    difference gives the halves' local error (Richardson), and a PI controller chooses the next
+    step; the halves are kept, so every accepted step is two ordinary steps of the method and
+    keeps its energy statement. The error is weighed per component as ``atol + rtol·|y|`` on the
+    position (m), the attitude (rad), the body velocities (m/s, rad/s) and the controller's
+    integrals; with one of ``rtol``, ``atol`` the other takes ``solve_ivp``'s default (1e-3,
+    1e-6). ``save_every`` counts accepted steps; ``Solution.meta["rejected"]`` counts the
+    rejected trials (docs/numerics.md).
     """
     if not isinstance(vessel, Vessel):
         raise _core.InvalidInputError(f"vessel must be a phsplit.Vessel, got {type(vessel).__name__}")
@@ -94,7 +107,10 @@ def simulate(
     if settings is None:
         settings = Settings(t_span=t_span, h=h, method=method, control_start=control_start, outer=outer,
                             save_every=save_every, linear_flow=linear_flow, ledger=ledger,
-                            project_invariants=project_invariants)
+                            project_invariants=project_invariants, rtol=rtol, atol=atol, h_max=h_max)
+    elif rtol is not None or atol is not None or h_max is not None:
+        raise _core.InvalidInputError("rtol, atol and h_max are settings: with settings=..., give them in the "
+                                      "Settings (dataclasses.replace(settings, rtol=...))")
     elif not isinstance(settings, Settings):
         raise _core.InvalidInputError(f"settings must be a phsplit.Settings, got {type(settings).__name__}")
     if isinstance(settings.save_every, float):
@@ -115,7 +131,20 @@ def simulate(
     if save_at is not None and settings.save_every != 1:
         raise _core.InvalidInputError(f"save_at gives the saved times itself, so save_every = {settings.save_every!r} "
                                       f"would not be used: give one of them")
-    if running_max and (save_at is not None or events):
+    if settings.adaptive and events:
+        raise _core.InvalidInputError(
+            "events are located on a fixed step grid; with adaptive steps (rtol, atol) drop the events, or "
+            "rtol and atol")
+    adaptive_at = None
+    if settings.adaptive and save_at is not None:
+        # The core's adaptive steps land on the output times themselves.
+        from .events import _check_times
+
+        if settings.save_every != 1:
+            raise _core.InvalidInputError(f"save_at gives the saved times itself, so save_every = "
+                                          f"{settings.save_every!r} would not be used: give one of them")
+        adaptive_at, save_at = np.ascontiguousarray(_check_times(save_at, *settings.t_span), dtype=float), None
+    if running_max and (save_at is not None or adaptive_at is not None or events):
         raise _core.InvalidInputError("running_max cannot be combined with save_at or events")
     if events is not None and not isinstance(events, (list, tuple)):
         events = [events]  # a single Event
@@ -141,8 +170,13 @@ def simulate(
                                       f"got {type(progress).__name__}")
     try:
         # _continuing: y0 is the last state of an earlier call of the same run, taken as it is.
-        return run(vessel, settings, y0, orthonormalize=bool(orthonormalize), callback=cb,
-                   running_max=bool(running_max), continuing=bool(_continuing))
+        sol = run(vessel, settings, y0, orthonormalize=bool(orthonormalize), callback=cb,
+                  running_max=bool(running_max), continuing=bool(_continuing), save_at=adaptive_at)
+        if adaptive_at is not None:
+            # Its rows are the output times, which a rerun of the recorded calls would not give
+            # (as for save_at with fixed steps).
+            sol.meta["provenance"].pop("chunks", None)
+        return sol
     finally:
         if bar is not None:
             bar.close()

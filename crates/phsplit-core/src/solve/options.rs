@@ -21,6 +21,72 @@ pub struct Options {
     pub outer: Outer,
     /// Compute the energy ledger.
     pub ledger: bool,
+    /// Adaptive steps to this tolerance (`h` is then the first step tried); `None`: fixed steps.
+    pub tolerance: Option<Tolerance>,
+}
+
+/// The tolerance of an adaptive run (`solve/adaptive.rs`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tolerance {
+    /// Relative tolerance (> 0).
+    pub rtol: f64,
+    /// Absolute tolerance (> 0), in the units of the model's error norm.
+    pub atol: f64,
+    /// Longest step (s).
+    pub h_max: f64,
+    /// End time (s).
+    pub t1: f64,
+    /// Output times (s, increasing, within the run): the steps land on them and only they are
+    /// saved, with the start and the end. Empty: every `save_every`-th accepted step.
+    pub save_at: Vec<f64>,
+}
+
+impl Tolerance {
+    /// Check the tolerance of a run from `t0`; the message names the setting and its range.
+    pub fn validate(&self, t0: f64) -> Result<()> {
+        use crate::model::vessel::params::compact;
+        for (name, v, top, text) in [
+            ("rtol", self.rtol, 1.0, "1"),
+            ("atol", self.atol, 1e3, "1e3"),
+        ] {
+            if !(v.is_finite() && v > 0.0 && v <= top) {
+                return Err(Error::InvalidInput(format!(
+                    "{name} must be a number in (0, {text}], got {}",
+                    compact(v)
+                )));
+            }
+        }
+        if self.rtol < 1e-13 {
+            return Err(Error::InvalidInput(format!(
+                "rtol must be at least 1e-13 (below it round-off decides the steps), got {}",
+                compact(self.rtol)
+            )));
+        }
+        if !(self.h_max.is_finite() && self.h_max > 0.0) {
+            return Err(Error::InvalidInput(format!(
+                "h_max must be finite and > 0 (s), got {}",
+                self.h_max
+            )));
+        }
+        if self
+            .save_at
+            .iter()
+            .any(|v| !v.is_finite() || *v < t0 || *v > self.t1)
+            || self.save_at.windows(2).any(|w| w[1] <= w[0])
+        {
+            return Err(Error::InvalidInput(format!(
+                "save_at must be strictly increasing finite times within [{t0}, {}] s",
+                self.t1
+            )));
+        }
+        if !(self.t1.is_finite() && self.t1 > t0) {
+            return Err(Error::InvalidInput(format!(
+                "the end time must be finite and after t0 = {t0} s, got {}",
+                self.t1
+            )));
+        }
+        Ok(())
+    }
 }
 
 /// Upper bound on the number of steps of one run.
@@ -38,6 +104,7 @@ impl Options {
             save_every,
             outer: Outer::Dissipative,
             ledger: true,
+            tolerance: None,
         }
     }
 

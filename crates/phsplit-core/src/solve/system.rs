@@ -233,6 +233,24 @@ pub trait Model {
     /// projection): update that memory. A model that keeps one must not let sub-steps merge
     /// across step boundaries ([`SplitModel::merges_exactly`]). Nothing by default.
     fn end_step(&self, _t_step: f64, _t1: f64, _s: &mut Self::State) {}
+    /// For adaptive steps: the root mean square of the components of the difference `a − b`,
+    /// each divided by `atol + rtol·max(|c_i|, |a_i|)`, with the components and their units the
+    /// model chooses (`c` the state the step started from). `None`: the model has no such norm.
+    fn error_norm(
+        &self,
+        _a: &Self::State,
+        _b: &Self::State,
+        _c: &Self::State,
+        _rtol: f64,
+        _atol: f64,
+    ) -> Option<f64> {
+        None
+    }
+    /// The first time after `t` at which the field switches (see [`Model::same_field`]), if
+    /// the model knows it: adaptive steps land on it.
+    fn next_switch(&self, _t: f64) -> Option<f64> {
+        None
+    }
     /// Why Runge–Kutta methods cannot integrate this model, if they cannot (a memory their
     /// kernel does not carry).
     fn runge_kutta_refused(&self) -> Option<String> {

@@ -63,8 +63,10 @@ pub struct Trajectory<S> {
     pub supplied: Vec<f64>,
     /// Energy dissipated since the previous saved state (0 for the first).
     pub dissipated: Vec<f64>,
-    /// Steps taken.
+    /// Steps taken (accepted steps of an adaptive run).
     pub steps: usize,
+    /// Trial steps rejected by an adaptive run's error control (0 for fixed steps).
+    pub rejected: usize,
     pub status: Status,
     /// The last finite state reached (the final state of a completed run).
     pub last_good: S,
@@ -106,6 +108,7 @@ impl<'m, M: Model> Recorder<'m, M> {
             supplied: Vec::with_capacity(capacity),
             dissipated: Vec::with_capacity(capacity),
             steps: 0,
+            rejected: 0,
             status: Status::Completed,
             last_good: y0.clone(),
             t_last_good: t0,

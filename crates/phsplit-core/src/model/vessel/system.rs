@@ -30,6 +30,7 @@ mod report;
 mod s1;
 mod s2;
 mod split;
+mod step_control;
 
 /// How flow S2 (linear) is integrated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -530,39 +531,21 @@ impl Model for VesselSystem<'_> {
         }
     }
     fn runge_kutta_refused(&self) -> Option<String> {
-        if self.own_dim > 0 {
-            // Each component with states of its own, by the name its states are reported under
-            // (`tank_eta` is the subsystem `tank` of `port_hamiltonian`).
-            let names: Vec<String> = self
-                .vessel
-                .own_layout()
-                .map(|(f, _)| {
-                    let first = f.own_states().first().map_or("", |o| o.name.as_str());
-                    match f.accounts().first() {
-                        _ if first.starts_with("observer_") => format!(
-                            "{} (its observer, control.feedback = \"observer\")",
-                            f.name()
-                        ),
-                        Some(a) if a.name != f.name() && first.starts_with(a.name) => {
-                            format!("{} (the subsystem {})", f.name(), a.name)
-                        }
-                        _ => f.name().to_string(),
-                    }
-                })
-                .collect();
-            let (what, verb) = if names.len() == 1 {
-                ("the component", "keeps states of its own")
-            } else {
-                ("the components", "keep states of their own")
-            };
-            return Some(format!(
-                "{what} {} {verb}, which the splitting methods integrate in flow S2 with the momenta and the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...)",
-                names.join(", ")
-            ));
-        }
-        (self.actuators > 0).then(|| {
-            "rate-limited thrusters (thrusters.unit[*].thrust_rate, turn_rate) keep a memory from step to step that the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...), or remove the rate limits".into()
-        })
+        self.runge_kutta_refusal()
+    }
+    fn error_norm(
+        &self,
+        a: &VesselState,
+        b: &VesselState,
+        c: &VesselState,
+        r: f64,
+        at: f64,
+    ) -> Option<f64> {
+        Some(self.motion_error(a, b, c, r, at))
+    }
+    fn next_switch(&self, t: f64) -> Option<f64> {
+        self.control_start
+            .filter(|&tc| !self.control_on(t) && tc > t)
     }
     fn project(&self, s: &mut VesselState) -> Work {
         for f in &self.vessel.forces {

@@ -187,6 +187,7 @@ mod tests {
                     save_every: 1,
                     outer: crate::methods::Outer::Dissipative,
                     ledger: true,
+                    tolerance: None,
                 };
                 let tr = run(&sys, &method, y0.clone(), &opts).unwrap();
                 let ks = tr.accounts.iter().position(|a| a.name == "spring").unwrap();

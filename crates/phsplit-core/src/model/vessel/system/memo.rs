@@ -274,6 +274,7 @@ mod tests {
                 save_every: 10,
                 outer,
                 ledger: true,
+                tolerance: None,
             };
             let tr = run(&sys, &method, v.initial_state(), &opts).unwrap();
             assert_eq!(sys.probe_assembles_whole(), whole, "{outer:?}");

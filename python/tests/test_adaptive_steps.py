@@ -1,0 +1,99 @@
+"""Adaptive steps for the splitting methods (``rtol``, ``atol``; ``solve/adaptive.rs``): step
+doubling with a PI controller, every accepted step two ordinary steps of the method.
+
+References are independent of the code under test: the paper's vessel written again in numpy
+(``reference.py``) and solved by scipy's DOP853 at rtol 1e-12."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import phsplit
+from phsplit import results
+
+import reference as ref
+
+V = phsplit.Vessel.paper()
+Y0 = V.initial_state()
+T_END = 400.0
+TS = np.arange(20.0, T_END + 1e-9, 20.0)
+
+
+@pytest.fixture(scope="module")
+def exact_positions() -> np.ndarray:
+    """The position at TS of the independent model, DP on from t = 0."""
+    f = ref.Field(V.to_dict(), True)
+    scale = np.maximum(np.abs(Y0), 1.0)
+    sol = solve_ivp(f, (0.0, T_END), Y0, method="DOP853", rtol=1e-12, atol=1e-12 * scale, t_eval=TS)
+    assert sol.success
+    return sol.y[18:21].T
+
+
+def _adaptive(method: str, tol: float, **kw) -> phsplit.Solution:
+    return phsplit.simulate(V, (0.0, T_END), 0.5, method, control_start=0.0, rtol=tol, atol=tol, save_at=TS, **kw)
+
+
+@pytest.mark.parametrize("method, p", [("sp2", 2), ("sp4", 4)])
+def test_the_error_falls_with_the_tolerance_against_an_independent_model(exact_positions, method, p):
+    """Error-per-step control: the global error ~ tol^(p/(p+1)) (fitted slope), falling and below 20 tol at
+    each tolerance, and the runs land on every output time exactly."""
+    tols = np.array([1e-2, 1e-3, 1e-4, 1e-5])
+    errs = []
+    for tol in tols:
+        sol = _adaptive(method, tol)
+        assert sol.status == "completed"
+        np.testing.assert_array_equal(sol.t, np.concatenate([[0.0], TS]))
+        errs.append(float(np.linalg.norm(sol.x[1:] - exact_positions, axis=1).max()))
+    errs = np.array(errs)
+    slope = np.polyfit(np.log(tols), np.log(errs), 1)[0]
+    assert 0.4 < slope < 1.2, (slope, errs)
+    assert np.all(np.diff(errs) < 0) and np.all(errs < 20 * tols), errs
+
+
+def test_every_saved_interval_balances_its_ledger_and_dissipates():
+    """Each accepted step is two positive steps of SP2: ΔH = supplied − dissipated per saved
+    interval to round-off, and the damping's booking is never negative."""
+    sol = phsplit.simulate(V, (0.0, 600.0), 0.5, "sp2", control_start=50.0, atol=1e-3)
+    led = sol.ledger
+    resid = np.abs(led.dH - (led.supplied - led.dissipated))[1:]
+    assert resid.max() < 1e-10 * np.abs(sol.energy).max(), resid.max()
+    assert np.all(led.by_account["damping"][1:] >= 0.0)
+    assert sol.meta["rejected"] >= 0 and sol.steps == len(sol.t) - 1
+
+
+def test_steps_land_on_the_controller_switch_and_lengthen_when_settled():
+    sol = phsplit.simulate(V, (0.0, 3600.0), 0.5, "sp4", control_start=50.0, atol=1e-3)
+    assert 50.0 in sol.t  # the switch is a step boundary, not the next one after it
+    dt = np.diff(sol.t)
+    early = np.median(dt[(sol.t[:-1] > 50.0) & (sol.t[:-1] < 200.0)])
+    late = np.median(dt[sol.t[:-1] > 3000.0])
+    assert late > 3 * early, (early, late)
+    assert sol.steps < 3600 / 0.5 / 4
+
+
+def test_h_max_bounds_the_steps_and_the_result_says_what_ran():
+    sol = phsplit.simulate(V, (0.0, 300.0), 0.5, "sp2", control_start=0.0, atol=1e-2, h_max=4.0)
+    assert np.diff(sol.t).max() <= 4.0 + 1e-12
+    ds = sol.to_xarray()
+    assert ds.attrs["step_size_s"] == "adaptive" and ds.attrs["atol"] == 1e-2 and ds.attrs["rtol"] == 1e-3
+    assert ds.attrs["rejected_steps"] == sol.meta["rejected"]
+    settings = results.settings_of(ds)
+    assert (settings.atol, settings.rtol, settings.h_max) == (1e-2, None, 4.0)
+
+
+def test_a_scenario_with_a_tolerance_runs_from_the_cli_and_reruns_bit_for_bit(tmp_path):
+    (tmp_path / "a.toml").write_text('[simulation]\nt_span = [0.0, 200.0]\nh = 0.5\nmethod = "sp4"\n'
+                                     'control_start = 0.0\natol = 1e-4\nname = "a"\n')
+    exe = os.path.join(os.path.dirname(sys.executable), "phsplit")
+    r = subprocess.run([exe, "simulate", "a.toml", "--out", "out", "--no-plot", "--h-max", "10"], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    (f,) = (tmp_path / "out").iterdir()
+    ds = results.open_dataset(f)
+    assert ds.attrs["atol"] == 1e-4 and np.diff(ds["time"].values.astype(float)).max() <= 10.0 + 1e-9
+    assert results.compare(ds, results.rerun(ds)) == []
