@@ -97,3 +97,24 @@ def test_a_scenario_with_a_tolerance_runs_from_the_cli_and_reruns_bit_for_bit(tm
     ds = results.open_dataset(f)
     assert ds.attrs["atol"] == 1e-4 and np.diff(ds["time"].values.astype(float)).max() <= 10.0 + 1e-9
     assert results.compare(ds, results.rerun(ds)) == []
+
+
+def test_steps_land_on_the_sensors_samples_and_on_a_thruster_loss():
+    """A sampled-data loop: with GNSS at 1 Hz and a gyro at 2 Hz the adaptive steps end on every
+    sample instant (the samples are taken where they are due, not at a later step end), and on
+    the time a thruster is lost."""
+    d = phsplit.Vessel.paper().to_dict()
+    d["control"]["feedback"] = "observer"
+    d["observer"] = {"wave_frequency": 0.7, "damping": [3.53933789e4, 1.1781388e5, 3.15094664584e8],
+                     "initial_estimate": [790.0, 28.0, 0.6]}
+    d["sensors"] = {"gnss_rate": 1.0, "gyro_rate": 2.0, "gnss_noise": 0.5, "gyro_noise": 0.002, "seed": 3}
+    sol = phsplit.simulate(phsplit.Vessel.from_dict(d), (0.0, 60.0), 0.5, "sp4", control_start=0.0, atol=1e-2)
+    assert sol.status == "completed"
+    assert set(np.arange(0.0, 60.01, 0.5)) <= set(np.round(sol.t, 9))
+    from phsplit import scenario
+
+    sc = scenario.load("pipelay")
+    d = sc.vessel.to_dict()
+    d["thrusters"]["unit"][0]["lost_at"] = 123.4
+    sol = phsplit.simulate(phsplit.Vessel.from_dict(d), (0.0, 200.0), 0.5, "sp2", control_start=0.0, atol=1e-2)
+    assert sol.status == "completed" and 123.4 in sol.t

@@ -21,8 +21,9 @@
 //!
 //! **Times.** Steps land exactly on the end of the run, on the requested output times
 //! ([`Tolerance::save_at`]: the states there are computed, not interpolated) and on the model's
-//! switches ([`super::system::Model::next_switch`]: the controller turned on), so a switch acts
-//! where it is due, not at the next step boundary after it.
+//! switches and events ([`super::system::Model::next_switch`]: the controller turned on, a
+//! sensor's sample, a thruster lost), so each acts where it is due, not at the next step
+//! boundary after it.
 
 use super::options::{Options, Tolerance};
 use super::system::{Flow, SplitModel, Work};

@@ -544,8 +544,11 @@ impl Model for VesselSystem<'_> {
         Some(self.motion_error(a, b, c, r, at))
     }
     fn next_switch(&self, t: f64) -> Option<f64> {
-        self.control_start
-            .filter(|&tc| !self.control_on(t) && tc > t)
+        let start = self
+            .control_start
+            .filter(|&tc| !self.control_on(t) && tc > t);
+        let events = self.vessel.forces.iter().filter_map(|f| f.next_event(t));
+        start.into_iter().chain(events).reduce(f64::min)
     }
     fn project(&self, s: &mut VesselState) -> Work {
         for f in &self.vessel.forces {

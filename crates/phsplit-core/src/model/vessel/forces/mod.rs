@@ -551,6 +551,10 @@ pub trait Force: Debug + Send + Sync {
     fn held_states(&self) -> Option<std::ops::Range<usize>> {
         None
     }
+    /// Its next event after `t` (a sensor's sample, a thruster lost): adaptive steps land on it.
+    fn next_event(&self, _t: f64) -> Option<f64> {
+        None
+    }
     /// Set its own states `x` from the body's state `s` where a run starts (the pipe's static
     /// shape under the hang-off point); by default they keep their declared initial values.
     fn init_own(&self, _s: &VesselState, _x: &mut [f64]) -> Result<()> {

@@ -523,6 +523,11 @@ impl Observer {
         }
     }
 
+    /// The sensors' next sample or dropout edge after `t`.
+    pub fn next_sample(&self, t: f64) -> Option<f64> {
+        self.sensors.as_ref().map(|sn| sn.next_event(t))
+    }
+
     /// Where the sensors' held measurements are in the own states.
     pub fn held_states(&self) -> Option<std::ops::Range<usize>> {
         self.sensors.as_ref().map(|_| N..N + HELD)

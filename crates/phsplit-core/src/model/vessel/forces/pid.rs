@@ -525,6 +525,11 @@ impl Force for Pid {
     fn held_states(&self) -> Option<std::ops::Range<usize>> {
         self.observer.as_ref().and_then(|o| o.held_states())
     }
+    fn next_event(&self, t: f64) -> Option<f64> {
+        let sample = self.observer.as_ref().and_then(|o| o.next_sample(t));
+        let loss = self.thrusters.as_ref().and_then(|th| th.next_loss(t));
+        sample.into_iter().chain(loss).reduce(f64::min)
+    }
     fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], out: &mut Vec<Output>) {
         if let Some(o) = &self.observer {
             o.outputs(fr, z, x, out);

@@ -85,6 +85,12 @@ impl Sensor {
     /// At time `t`, with its last sample's index `last` and validity `valid` (1 or 0): the
     /// index of the sample due now, if one is (a new instant passed, or back from a dropout),
     /// and whether it delivers.
+    /// The first sample instant `k / rate` or dropout edge after `t` (s).
+    fn next_event(&self, t: f64) -> f64 {
+        let k = (t * self.rate + 1e-9).floor() + 1.0;
+        let edges = self.dropout.iter().flat_map(|&(a, b)| [a, b]);
+        edges.filter(|&e| e > t).fold(k / self.rate, f64::min)
+    }
     fn due(&self, t: f64, last: f64, valid: f64) -> (Option<f64>, bool) {
         let k = (t * self.rate + 1e-9).floor();
         let delivers = !self.out_at(t);
@@ -223,6 +229,11 @@ fn normal(seed: u64, stream: u64, k: f64) -> f64 {
 }
 
 impl Sensors {
+    /// The next sample instant or dropout edge of either sensor after `t` (s).
+    pub fn next_event(&self, t: f64) -> f64 {
+        self.gnss.next_event(t).min(self.gyro.next_event(t))
+    }
+
     /// The own states' names, units and long names.
     pub fn states() -> [(&'static str, &'static str, &'static str); N] {
         [

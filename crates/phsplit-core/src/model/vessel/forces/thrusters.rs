@@ -345,6 +345,11 @@ impl Thrusters {
         Ok(self)
     }
 
+    /// The first time after `t` at which a thruster is lost.
+    pub fn next_loss(&self, t: f64) -> Option<f64> {
+        self.after.iter().map(|(tk, _)| *tk).find(|&tk| tk > t)
+    }
+
     /// The allocation at time `t` (s): without the thrusters lost by then.
     pub fn at(&self, t: f64) -> &Thrusters {
         self.after
