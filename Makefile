@@ -64,6 +64,7 @@ bench: $(VENV)/.built $(VENV)/.bench-deps
 	cargo bench -p phsplit-core --bench flows
 	$(BIN)/python benchmarks/work_precision.py
 	$(BIN)/python benchmarks/workloads.py
+	$(BIN)/python benchmarks/energy_accuracy.py
 	PHSPLIT_BENCH_PROJECT=1 $(BIN)/python benchmarks/work_precision.py --out benchmarks/results/projected
 	$(BIN)/python benchmarks/sweep_throughput.py
 	$(BIN)/python benchmarks/sweep_throughput.py --linear-flow exact

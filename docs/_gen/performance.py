@@ -59,6 +59,8 @@ def render() -> str:
     return "\n".join([
         "## Time to accuracy on the users' workloads\n",
         _markdown(RESULTS / "workloads.md", 3),
+        "## The default flow S2 and the energy accuracy\n",
+        _markdown(RESULTS / "energy_accuracy.md", 3),
         "## Work per step, work-precision, stability and memory: the paper's scheme\n",
         _markdown(RESULTS / "summary.md", 3),
         "## The same with the default projection\n",

@@ -1633,3 +1633,11 @@ CATALOGUE += [
     Bad("CLI: scenario with a zero rtol", cli(*SIM, "s.toml", files={
         "s.toml": b'[simulation]\nt_span = [0.0, 2.0]\nrtol = 0.0\n'}), C, ("rtol", "(0, 1]")),
 ]
+
+
+CATALOGUE += [
+    Bad("adaptive atol below round-off", sim(atol=1e-20), E, ("atol", "1e-12")),
+    Bad("adaptive h_max asking for too many steps", sim(atol=1e-3, h_max=1e-9), E, ("h_max", "at most")),
+    Bad("adaptive first step longer than h_max", sim(atol=1e-3, h=1.0, h_max=0.1), E, ("h_max", "h <= h_max")),
+    Bad("save_at as a 2-D array", sim(save_at=[[1.0, 2.0], [3.0, 4.0]]), E, ("save_at", "flat")),
+]

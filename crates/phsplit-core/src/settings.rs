@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::methods::{Method, Outer};
 use crate::model::vessel::params::unknown;
-use crate::model::vessel::LinearFlow;
+use crate::model::vessel::{LinearFlow, Vessel, VesselSystem};
 use crate::solve::{Options, Tolerance, MAX_STEPS};
 use toml::{Table, Value};
 
@@ -21,7 +21,7 @@ pub struct Settings {
     pub outer: Outer,
     /// Save every k-th step (and the last).
     pub save_every: usize,
-    pub linear_flow: LinearFlow,
+    pub linear_flow: FlowChoice,
     /// Keep the energy ledger.
     pub ledger: bool,
     /// Project after every step onto the invariants of the exact flow that the split does not
@@ -37,10 +37,10 @@ pub struct Settings {
 
 impl Default for Settings {
     /// The paper's Fig. 2 run: SP4, h = 0.5 s on [0, 200] s, the controller from t = 50 s
-    /// (paper §4), S2 outermost, every step saved, the ledger on; flow S2 by Gauss collocation,
-    /// which reached every accuracy of the work-precision study 2 to 8 times sooner than the
-    /// exact flow with SP4 and SP6 (README). The paper's own scheme, the exact S2
-    /// (§3.4.2), is `linear_flow = "exact"`: the Fig. 2 scenario and the reproduction pin it.
+    /// (paper §4), S2 outermost, every step saved, the ledger on; flow S2 `"auto"`: exact where
+    /// it acts and is the cheaper (see [`FlowChoice::Auto`]), Gauss collocation elsewhere. The
+    /// paper's own scheme, the exact S2 (§3.4.2), is `linear_flow = "exact"`: the Fig. 2
+    /// scenario and the reproduction pin it.
     fn default() -> Self {
         Self {
             t_span: (0.0, 200.0),
@@ -49,12 +49,69 @@ impl Default for Settings {
             control_start: Some(50.0),
             outer: Outer::Dissipative,
             save_every: 1,
-            linear_flow: LinearFlow::Gauss,
+            linear_flow: FlowChoice::Auto,
             ledger: true,
             project_invariants: true,
             rtol: None,
             atol: None,
             h_max: None,
+        }
+    }
+}
+
+/// How flow S2 is chosen: as the user names it, or by the vessel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FlowChoice {
+    /// The exact S2 where it acts (no forcing part: docs/model.md §3.7) on a vessel whose mass
+    /// matrix has the paper's diagonal form and whose components keep no states of their own
+    /// (their exact flow is the dense system's, several times a collocated step); Gauss
+    /// collocation otherwise. Measured
+    /// (`benchmarks/energy_accuracy.py`, `benchmarks/workloads.py`): on the paper's vessel the
+    /// exact S2 reached the energy accuracies of Fig. 4 sooner (SP2 reached 1e-3 only with it)
+    /// and the workloads' 1 cm sooner at fixed steps; with a general mass matrix the exact
+    /// coupled S2 costs several times a collocated step (docs/performance.md).
+    Auto,
+    /// The flow named.
+    Named(LinearFlow),
+}
+
+impl std::str::FromStr for FlowChoice {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "auto" => Ok(FlowChoice::Auto),
+            "exact" | "gauss" => Ok(FlowChoice::Named(s.parse()?)),
+            other => Err(Error::InvalidInput(format!(
+                "linear_flow must be 'auto' (exact where it acts on a diagonal mass matrix, else Gauss), 'exact' (matrix exponential) or 'gauss' (Gauss collocation / diagonal Padé), got {other:?}"
+            ))),
+        }
+    }
+}
+
+impl FlowChoice {
+    pub fn name(self) -> &'static str {
+        match self {
+            FlowChoice::Auto => "auto",
+            FlowChoice::Named(f) => f.name(),
+        }
+    }
+    /// The flow S2 a run of `vessel` takes, with fixed or `adaptive` steps. Adaptive steps
+    /// take Gauss: each step has its own length, so the exact flow's exponentials are not
+    /// reused from step to step (`benchmarks/workloads.py`: the paper's hour to 1 cm by SP2
+    /// adaptive took about three times as long with the exact S2).
+    pub fn for_vessel(self, vessel: &Vessel, adaptive: bool) -> LinearFlow {
+        match self {
+            FlowChoice::Named(f) => f,
+            FlowChoice::Auto if adaptive => LinearFlow::Gauss,
+            FlowChoice::Auto => {
+                let exact = VesselSystem::new(vessel, None).s2_solver() == LinearFlow::Exact;
+                let own = vessel.own_layout().next().is_some();
+                if exact && vessel.body.is_diagonal() && !own {
+                    LinearFlow::Exact
+                } else {
+                    LinearFlow::Gauss
+                }
+            }
         }
     }
 }
@@ -70,7 +127,7 @@ pub const KEYS: [(&str, &str); 13] = [
     ),
     ("outer", "'dissipative' or 'conservative'"),
     ("save_every", "an integer >= 1"),
-    ("linear_flow", "'exact' or 'gauss'"),
+    ("linear_flow", "'auto', 'exact' or 'gauss'"),
     ("ledger", "true or false"),
     ("project_invariants", "true or false"),
     ("rtol", "relative tolerance of adaptive steps, in (0, 1]"),
@@ -229,6 +286,12 @@ impl Settings {
         let tolerance = self.tolerance()?;
         if let Some(tol) = &tolerance {
             tol.validate(t0)?;
+            if self.h > tol.h_max {
+                return Err(Error::InvalidInput(format!(
+                    "h = {} s, the first adaptive step tried, is longer than h_max = {} s: give h <= h_max",
+                    self.h, tol.h_max
+                )));
+            }
             if matches!(self.method, Method::RungeKutta(_)) {
                 return Err(Error::InvalidInput(format!(
                     "adaptive steps (rtol, atol) are for the splitting methods (lie, sp2, mcl2, sp4, sp6); {} runs with a fixed step here: drop rtol and atol, or choose a splitting method",
@@ -386,7 +449,7 @@ mod tests {
             ("h = 300", "longer than t_span"),
             ("t_span = [0, 1e300]\nh = 1e-300", "at most"),
             ("outer = \"S1\"", "dissipative"),
-            ("linear_flow = \"pade\"", "gauss"),
+            ("linear_flow = \"pade\"", "'auto'"),
             ("ledger = 1", "true or false"),
             ("name = \"../../escape\"", "simulation.name must be"),
             ("name = \"\"", "simulation.name must be"),

@@ -442,7 +442,7 @@ impl Layout {
             "linear_flow",
             Val::String(s.linear_flow.name().into()),
             "",
-            "flow S2: 'exact' or 'gauss'",
+            "flow S2: 'auto' (exact where it acts on a diagonal mass matrix, else Gauss), 'exact' or 'gauss'",
         );
         b.setting(
             "outer",

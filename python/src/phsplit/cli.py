@@ -104,9 +104,10 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--t-end", type=float, help="override the end time, s")
     s.add_argument("--save-every", type=int, help="save every k-th step (decimation)")
     s.add_argument("--control-start", help="override the controller's start time, s, or 'never'")
-    s.add_argument("--linear-flow", choices=["exact", "gauss"],
-                   help="flow S2 by Gauss collocation (the library's default) or exactly (matrix "
-                   "exponentials, the paper's; the default of the Fig. 2 scenario)")
+    s.add_argument("--linear-flow", choices=["auto", "exact", "gauss"],
+                   help="flow S2: 'auto' (the library's default: exact where it acts on a diagonal mass "
+                   "matrix, else Gauss collocation), exactly (matrix exponentials, the paper's; the default "
+                   "of the Fig. 2 scenario) or by Gauss collocation")
     s.add_argument("--rtol", type=float, help="adaptive steps to this relative tolerance (--h: the first step)")
     s.add_argument("--atol", type=float, help="adaptive steps to this absolute tolerance (m, rad, m/s, rad/s)")
     s.add_argument("--h-max", type=float, help="longest adaptive step, s")

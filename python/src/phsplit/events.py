@@ -194,9 +194,12 @@ def _check_times(save_at, t0: float, t1: float) -> np.ndarray:
             isinstance(save_at, np.ndarray) and save_at.dtype.kind not in "fiu"):
         raise _core.InvalidInputError(f"save_at must be a sequence of times (s), numbers, got {save_at!r}")
     try:
-        ts = np.asarray(save_at, dtype=float).reshape(-1)
+        ts = np.asarray(save_at, dtype=float)
     except (TypeError, ValueError):
         raise _core.InvalidInputError("save_at must be a sequence of times (s)") from None
+    if ts.ndim > 1:
+        raise _core.InvalidInputError(f"save_at must be a flat sequence of times (s), got an array of shape {ts.shape}")
+    ts = ts.reshape(-1)
     if ts.size == 0:
         raise _core.InvalidInputError("save_at is empty: give at least one time (s)")
     if not np.all(np.isfinite(ts)):
@@ -404,6 +407,37 @@ def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
     sol.meta["events"] = hits
     sol.meta.pop("provenance", None)  # several core calls: not rerunnable as one
     return sol
+
+
+def only_times(sol, times: np.ndarray, settings):
+    """An adaptive run that landed on ``times`` (with its start and end) cut to exactly those
+    rows, the ledger between them, as ``save_at`` with fixed steps gives them (numpy slices of
+    the one call's arrays)."""
+    names = list(sol.ledger.by_account)
+    per_step = _booked_steps(sol, names)
+    idx = np.flatnonzero(np.isin(sol.t, np.asarray(times, dtype=float)))
+    if sol.status != "completed" and (idx.size == 0 or idx[-1] != len(sol.t) - 1):
+        idx = np.append(idx, len(sol.t) - 1)  # the last state before the failure, as plain simulate returns it
+    if idx.size == 0:
+        raise _core.InvalidInputError("nothing was computed: the run failed at its first step")
+    # Each kept row's booking: the sum over the steps since the kept row before (summed per
+    # interval, not differenced from a running total, which would lose its digits).
+    booked = np.zeros((idx.size, len(names)))
+    if idx.size > 1:
+        booked[1:] = np.add.reduceat(per_step[: idx[-1] + 1], idx[:-1] + 1, axis=0)
+    kinds = sol.ledger.kinds
+    sup = sum((booked[:, k] for k, nm in enumerate(names) if kinds[nm] == "supplied"), np.zeros(idx.size))
+    dis = sum((booked[:, k] for k, nm in enumerate(names) if kinds[nm] == "dissipated"), np.zeros(idx.size))
+    meta = {k: v for k, v in sol.meta.items() if k != "provenance"}  # not rerunnable as one call
+    return solution_of(
+        {"t": np.asarray(sol.t)[idx], **{f: np.asarray(getattr(sol, f))[idx] for f in _FIELDS}}, booked, names,
+        kinds, sup, dis, controls=sol.ledger.controls, status=sol.status, method=sol.method, h=sol.h,
+        control_start=sol.control_start, steps=sol.steps, failure=sol.failure, last_good_state=sol.last_good_state,
+        meta=meta, settings=dict(sol.settings),
+        outputs={k: (u, ln, np.asarray(v)[idx]) for k, (u, ln, v) in sol.outputs.items()},
+        actuators=None if sol.actuators is None else np.asarray(sol.actuators)[idx],
+        own=None if sol.own is None else np.asarray(sol.own)[idx],
+    )
 
 
 def dense_output(sol, times):

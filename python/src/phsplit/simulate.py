@@ -62,10 +62,13 @@ def simulate(
     again; it changes no energy (docs/model.md §3.6); ``False`` runs the paper's scheme as
     printed. ``initial`` overrides the vessel's initial state: a flat 27-vector (for rate-limited thrusters optionally
     followed by their memory, as :meth:`Solution.state` gives it) or a mapping with ``euler``, ``position``, ``velocity``,
-    ``angular_velocity``. ``linear_flow`` integrates the linear flow S2 by Gauss collocation of
-    the method's order (``"gauss"``, the default: the diagonal Padé approximant, same order,
-    still passive, paper Remark 2.3; 2 to 8 times sooner to a given accuracy, README) or
-    exactly (``"exact"``, matrix exponentials: the paper's scheme, §3.4.2). An initial
+    ``angular_velocity``. ``linear_flow`` integrates the linear flow S2 exactly
+    (``"exact"``, matrix exponentials: the paper's scheme, §3.4.2) or by Gauss collocation of
+    the method's order (``"gauss"``: the diagonal Padé approximant, same order, still passive,
+    paper Remark 2.3); ``"auto"``, the default, takes the exact flow with fixed steps where
+    it acts on a vessel with the paper's diagonal mass matrix and no component states, Gauss
+    elsewhere and with adaptive steps (measured: docs/how-to,
+    "The linear flow S2"); ``Solution.meta["s2_solver"]`` says which ran. An initial
     attitude that is not a rotation is rejected unless ``orthonormalize=True`` asks for its
     projection to the nearest rotation. ``settings`` (a :class:`Settings`) replaces all the
     settings arguments at once.
@@ -173,9 +176,11 @@ def simulate(
         sol = run(vessel, settings, y0, orthonormalize=bool(orthonormalize), callback=cb,
                   running_max=bool(running_max), continuing=bool(_continuing), save_at=adaptive_at)
         if adaptive_at is not None:
-            # Its rows are the output times, which a rerun of the recorded calls would not give
-            # (as for save_at with fixed steps).
-            sol.meta["provenance"].pop("chunks", None)
+            # Exactly the rows asked for (the core also saves the start and the end), as with
+            # fixed steps; not rerunnable as one call, as save_at with fixed steps.
+            from .events import only_times
+
+            return only_times(sol, adaptive_at, settings)
         return sol
     finally:
         if bar is not None:

@@ -44,12 +44,7 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     opts.validate()?;
     tol.validate(opts.t0)?;
     model.supports_order(method.order)?;
-    let (fa, fb) = opts.outer.flows();
-    let subs: Vec<(Flow, f64)> = method
-        .substeps
-        .iter()
-        .map(|&(is_a, c)| (if is_a { fa } else { fb }, c))
-        .collect();
+    let subs = super::kernel::flows_of(method, opts);
     let p = method.order as i32;
     let k = f64::from(p + 1);
     let richardson = f64::from(2i32.pow(p as u32) - 1);
@@ -71,6 +66,9 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     let (mut accepted, mut rejected) = (0usize, 0usize);
     // Round-off guards: a step lands on the end (or a switch) when it would leave a sliver.
     let resolution = 64.0 * f64::EPSILON * t0.abs().max(t1.abs()).max(1.0);
+    // Below this step the tolerance is taken as unreachable (a blow-up, or a discontinuity the
+    // steps cannot resolve): the run stops as failed instead of creeping on.
+    let h_min = resolution.max(1e-10 * span);
     let saves = &tol.save_at;
     let mut next_save = saves.partition_point(|&ts| ts <= t0 + resolution);
     loop {
@@ -130,10 +128,10 @@ pub fn run_splitting_adaptive<M: SplitModel>(
                 0.2
             };
             h = hn * fac;
-            if h <= resolution || accepted + rejected >= super::MAX_STEPS {
+            if h <= h_min || accepted + rejected >= super::MAX_STEPS {
                 rec.traj.steps = accepted;
                 rec.traj.rejected = rejected;
-                let why = if h <= resolution {
+                let why = if h <= h_min {
                     format!(
                         "the step size fell to {h:.3e} s without meeting rtol = {:e}, atol = {:e} (a blow-up or a discontinuity the steps cannot resolve)",
                         tol.rtol, tol.atol

@@ -39,12 +39,7 @@ pub fn run_splitting_watched<M: SplitModel>(
 ) -> Result<Trajectory<M::State>> {
     opts.validate()?;
     model.supports_order(method.order)?;
-    let (fa, fb) = opts.outer.flows();
-    let subs: Vec<(Flow, f64)> = method
-        .substeps
-        .iter()
-        .map(|&(is_a, c)| (if is_a { fa } else { fb }, c))
-        .collect();
+    let subs = flows_of(method, opts);
     let fsal = subs.len() > 1 && subs[0].0 == subs[subs.len() - 1].0;
     let last = subs.len() - 1;
     let mut y0 = y0;
@@ -122,6 +117,16 @@ pub fn run_splitting_watched<M: SplitModel>(
         }
     }
     Ok(rec.traj)
+}
+
+/// A composition's sub-steps as flows, with the outer flow the options choose.
+pub(super) fn flows_of(method: &Composition, opts: &Options) -> Vec<(Flow, f64)> {
+    let (fa, fb) = opts.outer.flows();
+    method
+        .substeps
+        .iter()
+        .map(|&(is_a, c)| (if is_a { fa } else { fb }, c))
+        .collect()
 }
 
 /// The index of a flow's clock.

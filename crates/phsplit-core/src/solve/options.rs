@@ -62,6 +62,12 @@ impl Tolerance {
                 compact(self.rtol)
             )));
         }
+        if self.atol < 1e-12 {
+            return Err(Error::InvalidInput(format!(
+                "atol must be at least 1e-12 (m, rad, m/s, rad/s: below it round-off of the position and attitude decides the steps), got {}",
+                compact(self.atol)
+            )));
+        }
         if !(self.h_max.is_finite() && self.h_max > 0.0) {
             return Err(Error::InvalidInput(format!(
                 "h_max must be finite and > 0 (s), got {}",
@@ -83,6 +89,13 @@ impl Tolerance {
             return Err(Error::InvalidInput(format!(
                 "the end time must be finite and after t0 = {t0} s, got {}",
                 self.t1
+            )));
+        }
+        let n = (self.t1 - t0) / self.h_max;
+        if n > super::MAX_STEPS as f64 {
+            return Err(Error::InvalidInput(format!(
+                "t_span / h_max asks for at least {n:.3e} steps; a run takes at most {:.0e} steps (take a longer h_max)",
+                super::MAX_STEPS as f64
             )));
         }
         Ok(())
