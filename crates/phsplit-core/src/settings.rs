@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::methods::{Method, Outer};
 use crate::model::vessel::params::unknown;
-use crate::model::vessel::{LinearFlow, Vessel, VesselSystem};
+use crate::model::vessel::{LinearFlow, Vessel};
 use crate::solve::{Options, Tolerance, MAX_STEPS};
 use toml::{Table, Value};
 
@@ -104,9 +104,10 @@ impl FlowChoice {
             FlowChoice::Named(f) => f,
             FlowChoice::Auto if adaptive => LinearFlow::Gauss,
             FlowChoice::Auto => {
-                let exact = VesselSystem::new(vessel, None).s2_solver() == LinearFlow::Exact;
+                // As `VesselSystem::s2_solver`: the exact flow acts where no component forces S2.
+                let forced = vessel.forces.iter().any(|f| f.forced());
                 let own = vessel.own_layout().next().is_some();
-                if exact && vessel.body.is_diagonal() && !own {
+                if !forced && vessel.body.is_diagonal() && !own {
                     LinearFlow::Exact
                 } else {
                     LinearFlow::Gauss

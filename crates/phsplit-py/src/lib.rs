@@ -277,6 +277,9 @@ pub(crate) fn settings_dict<'py>(
     d.set_item("rtol", s.rtol)?;
     d.set_item("atol", s.atol)?;
     d.set_item("h_max", s.h_max)?;
+    // The tolerance an adaptive run takes (the defaults of a missing one filled in), or None.
+    let tol = s.tolerance().ok().flatten();
+    d.set_item("tolerance", tol.map(|t| (t.rtol, t.atol, t.h_max)))?;
     let steps = s.steps().ok();
     d.set_item("n_steps", steps.map(|x| x.0))?;
     d.set_item("last_h", steps.map(|x| x.1))?;

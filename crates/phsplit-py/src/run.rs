@@ -442,7 +442,7 @@ impl PyVectorField {
                     .map_err(|e| format!("{e:?}"))?;
                 state = *sol.y.last().ok_or("no output")?;
                 for (t, y) in sol.t.iter().zip(&sol.y) {
-                    if t_eval.contains(t) {
+                    if t_eval.binary_search_by(|x| x.total_cmp(t)).is_ok() {
                         rows.extend_from_slice(y.as_slice());
                     }
                 }

@@ -341,12 +341,13 @@ class Solution:
             # How flow S2 was integrated: the linear flow asked for, or Gauss collocation where S2
             # has a forcing part (runner.SettingWarning).
             ds.attrs["s2_solver"] = str(self.meta["s2_solver"])
-        if self.settings.get("rtol") is not None or self.settings.get("atol") is not None:
-            # Adaptive steps: the tolerance and how the error control went (docs/numerics.md).
+        if self.settings.get("tolerance") is not None:
+            # Adaptive steps: the tolerance the core took and how the error control went
+            # (docs/numerics.md).
+            rtol, atol, _ = self.settings["tolerance"]
             ds.attrs["step_size_s"] = "adaptive"
             ds.attrs["first_step_s"] = self.h
-            ds.attrs["rtol"] = float(self.settings["rtol"] if self.settings.get("rtol") is not None else 1e-3)
-            ds.attrs["atol"] = float(self.settings["atol"] if self.settings.get("atol") is not None else 1e-6)
+            ds.attrs["rtol"], ds.attrs["atol"] = float(rtol), float(atol)
             ds.attrs["rejected_steps"] = int(self.meta.get("rejected", 0))
         if self.failure:
             ds.attrs["failure"] = self.failure

@@ -69,6 +69,8 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     // Below this step the tolerance is taken as unreachable (a blow-up, or a discontinuity the
     // steps cannot resolve): the run stops as failed instead of creeping on.
     let h_min = resolution.max(1e-10 * span);
+    // The trials' states, reused from trial to trial (a model's state may own a heap part).
+    let (mut whole, mut halves) = (y.clone(), y.clone());
     let saves = &tol.save_at;
     let mut next_save = saves.partition_point(|&ts| ts <= t0 + resolution);
     loop {
@@ -86,10 +88,10 @@ pub fn run_splitting_adaptive<M: SplitModel>(
         }
         let last = clipped && to == t1;
         let at_save = clipped && saves.get(next_save) == Some(&to);
-        let mut whole = y.clone();
+        whole.clone_from(&y);
         // The whole step is only compared: its ledger is not needed.
         one_step(model, &subs, method.order, false, hn, t, &mut whole);
-        let mut halves = y.clone();
+        halves.clone_from(&y);
         let mut w = one_step(
             model,
             &subs,
@@ -152,7 +154,7 @@ pub fn run_splitting_adaptive<M: SplitModel>(
             continue;
         }
         // Accepted: the two halves.
-        y = halves;
+        std::mem::swap(&mut y, &mut halves);
         rec.acc += w;
         accepted += 1;
         t = if clipped { to } else { t + hn };
@@ -208,10 +210,7 @@ fn one_step<M: SplitModel>(
     let mut clock = [t, t];
     for &(flow, c) in subs {
         let len = c * h;
-        let k = match flow {
-            Flow::S1 => 0,
-            Flow::S2 => 1,
-        };
+        let k = super::kernel::flow_index(flow);
         let start = clock[k];
         clock[k] += len;
         acc += model.flow(flow, len, t, start, order, ledger, y);

@@ -130,7 +130,7 @@ pub(super) fn flows_of(method: &Composition, opts: &Options) -> Vec<(Flow, f64)>
 }
 
 /// The index of a flow's clock.
-fn flow_index(f: Flow) -> usize {
+pub(super) fn flow_index(f: Flow) -> usize {
     match f {
         Flow::S1 => 0,
         Flow::S2 => 1,
