@@ -54,6 +54,8 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "euler_reference": ("rad", REQ, "set attitude (roll, pitch, yaw), each within ±2π"),
         "position_reference": ("m", REQ, "set position, spatial frame"),
         "feedback": ("-", '"true_state"', '`"true_state"` (the paper\'s) or `"observer"`: the controller acts on the estimates of `[observer]` (§5.20)'),
+        "anti_windup": ("-", '"none"', '`"none"` or `"back_calculation"` (Åström–Hägglund): the integral states are pulled towards what `[thrusters]` deliver while they saturate; needs `[thrusters]` and an integral gain'),
+        "tracking_time": ("s", "√(kd/ki) per axis", "back-calculation's tracking time `T_t` for every axis, in (0, 86400]; needs `anti_windup = \"back_calculation\"`"),
     },
     "observer": {
         "wave_frequency": ("rad/s", REQ, "`ω₀` of the wave model, in (0, 10]: the sea's peak frequency (§5.20)"),

@@ -64,6 +64,21 @@ class Field:
         self.xr = np.array(c["position_reference"])
         self.thr = np.array(c["euler_reference"])
         self.on = control_on
+        # back-calculation anti-windup (Astrom & Hagglund, Advanced PID Control, 2006, 3.5): the
+        # integral term I = Ki phi follows I' = Ki e + (v - u)/Tt, with the command u and the
+        # delivered v in the controller's coordinates (Y in tau = -Q^T Y, -W^T Y) and
+        # Tt = sqrt(Ti Td) = sqrt(kd/ki) per axis (Ti = kp/ki where kd = 0), or control.tracking_time
+        self.aw = None
+        if c.get("anti_windup", "none") == "back_calculation":
+            def tt(kp, kd, ki):
+                kp, kd, ki = (np.asarray(c[n], float) for n in (kp, kd, ki))
+                t = c.get("tracking_time")
+                k1 = np.where(ki > 0, ki, 1.0)
+                rule = np.where(kd > 0, np.sqrt(kd / k1), kp / k1)
+                tr = np.full(3, float(t)) if t is not None else rule
+                return np.where(ki > 0, 1.0 / (k1 * np.where(tr > 0, tr, 1.0)), 0.0)
+            self.aw = (tt("kp_translational", "kd_translational", "ki_translational"),
+                       tt("kp_rotational", "kd_rotational", "ki_rotational"))
         ext = params.get("external")
         self.ext = None
         if ext:
@@ -306,8 +321,15 @@ class Field:
                         + K["ki_translational"] @ phx)
         tau_r = -W.T @ (K["kp_rotational"] @ (th - thr) + K["kd_rotational"] @ (W @ w - thd)
                         + K["ki_rotational"] @ phth)
+        aw_t, aw_r = np.zeros(3), np.zeros(3)
         if self.thr_units is not None and self.on:
+            dem_t, dem_r = tau_t, tau_r
             tau_t, tau_r = self.thrust(tau_t, tau_r)
+            if self.aw is not None:
+                # the deficits of what is delivered in surge, sway and yaw, as commands Y
+                y_t = -Q @ np.array([tau_t[0] - dem_t[0], tau_t[1] - dem_t[1], 0.0])
+                y_r = -np.linalg.solve(W.T, np.array([0.0, 0.0, tau_r[2] - dem_r[2]]))
+                aw_t, aw_r = self.aw[0] * y_t, self.aw[1] * y_r
         fe, me = self.external(Q)
         if self.wind is not None:
             fw, mw = self.wind_loads(t, v, Q)
@@ -353,8 +375,8 @@ class Field:
         dy[6:15] = (Q @ hat(w)).reshape(-1, order="F")
         dy[15:18] = -self.G * np.cross(w, q3)
         dy[18:21] = Q @ v
-        dy[21:24] = (th - thr) if self.on else 0.0
-        dy[24:27] = (x - xr) if self.on else 0.0
+        dy[21:24] = (th - thr + aw_r) if self.on else 0.0
+        dy[24:27] = (x - xr + aw_t) if self.on else 0.0
         return dy
 
     def control_torque(self, y):

@@ -146,9 +146,18 @@ pub mod physical {
         hi_closed: true,
         why: "within 1e9 s (about 30 years) of t = 0",
     };
+    /// A controller's time constant (s): positive, and a day at most (a DP controller's
+    /// integral acts over minutes).
+    pub const TRACKING_TIME: Physical = Physical {
+        lo: 0.0,
+        hi: 86400.0,
+        lo_closed: false,
+        hi_closed: true,
+        why: "a controller's time constant is positive and at most a day",
+    };
 
     /// Every named range, for the documentation.
-    pub const ALL: [(&str, &str, Physical); 8] = [
+    pub const ALL: [(&str, &str, Physical); 9] = [
         ("hull length", "m", HULL_LENGTH),
         ("hull beam", "m", HULL_BEAM),
         ("draught", "m", DRAFT),
@@ -157,6 +166,7 @@ pub mod physical {
         ("angle in degrees", "degrees", ANGLE_DEG),
         ("pipe departure angle", "degrees", DEPARTURE_ANGLE),
         ("schedule time", "s", TIME),
+        ("controller time constant", "s", TRACKING_TIME),
     ];
 }
 

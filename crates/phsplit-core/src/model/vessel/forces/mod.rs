@@ -47,6 +47,7 @@ use std::sync::Arc;
 
 pub use own::{Output, OwnLinear, OwnState};
 
+pub mod anti_windup;
 pub mod crossflow;
 pub mod current;
 pub mod damping;

@@ -30,6 +30,7 @@
 //! times. It is booked with the P and I terms as `control` (the `Kd x_d'` term too: it is a
 //! port term, not dissipation).
 
+use super::anti_windup::{self, AntiWindup, PidGains};
 use super::observer::{self, Observer};
 use super::thrusters::{self, Thrusters};
 use super::{Force, Forcing, Frozen, Output, OwnLinear, OwnState, Rows, S2Builder, Sys};
@@ -59,6 +60,9 @@ pub struct Pid {
     /// The thrusters that deliver the controller's force, if any (else it acts unlimited, as
     /// in the paper).
     pub thrusters: Option<Thrusters>,
+    /// Back-calculation of the integral states while the thrusters saturate, if asked for
+    /// (`anti_windup.rs`).
+    pub anti_windup: Option<AntiWindup>,
     /// With `feedback = "observer"`: the observer whose estimates the controller acts on
     /// (`observer.rs`); else it acts on the vessel's state.
     pub observer: Option<Observer>,
@@ -85,6 +89,14 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     let position_reference = p.vec3("control", "position_reference", None, "m", Range::Finite)?;
     let setpoint = super::setpoint::read(p, &euler_reference)?;
     let thrusters = thrusters::read(p)?;
+    let anti_windup = anti_windup::read(
+        p,
+        &PidGains {
+            translational: [&kp_translational, &kd_translational, &ki_translational],
+            rotational: [&kp_rotational, &kd_rotational, &ki_rotational],
+        },
+        thrusters.is_some(),
+    )?;
     p.declare("observer");
     let observer = match p.choice("control", "feedback", &["true_state", "observer"])? {
         "observer" => {
@@ -122,6 +134,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     Ok(Some(Arc::new(Pid {
         setpoint,
         thrusters,
+        anti_windup,
         observer,
         kp_translational,
         kd_translational,
@@ -456,6 +469,11 @@ impl Force for Pid {
                     0 => th.wrench(&tau),
                     _ => th.wrench_of(&th.delivered(&tau, &fr.actuators, t - fr.actuators.t)),
                 };
+                if let Some(aw) = &self.anti_windup {
+                    let [rt, rr] = aw.rates(fr, (&f, &m), (&force, &moment));
+                    g.rate_w(Sys::Trans, rt);
+                    g.rate_w(Sys::Rot, rr);
+                }
                 // What the thrusters deliver, less the affine part already in flow S2.
                 let (rt, rr) = Self::allocated_rows(&r);
                 g.force(Sys::Trans, Some(0), force - rt.at(&nu, &z[0]));
