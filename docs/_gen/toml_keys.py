@@ -457,6 +457,7 @@ RANGE_KEYS = {
     "angle in degrees": "`pipe.lay_direction`, `thrusters.unit[i].angle`",
     "pipe departure angle": "`pipe.departure_angle`",
     "schedule time": "`setpoint.times`, `setpoint.start_time`, `current.times`",
+    "controller time constant": "`control.tracking_time`",
 }
 
 
