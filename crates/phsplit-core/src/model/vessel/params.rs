@@ -146,8 +146,7 @@ pub mod physical {
         hi_closed: true,
         why: "within 1e9 s (about 30 years) of t = 0",
     };
-    /// A controller's time constant (s): positive, and a day at most (a DP controller's
-    /// integral acts over minutes).
+    /// A controller's time constant (s): positive, at most a day (DP integrals act in minutes).
     pub const TRACKING_TIME: Physical = Physical {
         lo: 0.0,
         hi: 86400.0,
