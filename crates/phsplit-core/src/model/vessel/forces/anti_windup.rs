@@ -29,6 +29,7 @@
 
 use super::Frozen;
 use crate::error::Error;
+use crate::lie::so3;
 use crate::model::vessel::params::{physical, Params, Range};
 use nalgebra::Vector3;
 
@@ -37,8 +38,6 @@ use nalgebra::Vector3;
 #[derive(Debug, Clone, PartialEq)]
 pub struct AntiWindup {
     pub gain: [Vector3<f64>; 2],
-    /// `T_t` per axis (s; zero where there is no integral), for the outputs and the docs.
-    pub tracking_time: [Vector3<f64>; 2],
 }
 
 /// The controller's gains the rule reads: `[kp, kd, ki]` for translation and for rotation.
@@ -72,7 +71,6 @@ pub fn read(p: &mut Params, g: &PidGains, thrusters: bool) -> crate::Result<Opti
         ));
     }
     let mut gain = [Vector3::zeros(); 2];
-    let mut time = [Vector3::zeros(); 2];
     let mut any = false;
     for (k, [kp, kd, ki]) in [g.translational, g.rotational].into_iter().enumerate() {
         for j in 0..3 {
@@ -95,7 +93,6 @@ pub fn read(p: &mut Params, g: &PidGains, thrusters: bool) -> crate::Result<Opti
                 }
             };
             gain[k][j] = 1.0 / (ki[j] * tt);
-            time[k][j] = tt;
             any = true;
         }
     }
@@ -104,10 +101,7 @@ pub fn read(p: &mut Params, g: &PidGains, thrusters: bool) -> crate::Result<Opti
             "control.anti_windup = \"back_calculation\" acts on the integral states, and every integral gain (ki_translational, ki_rotational) is zero: set anti_windup = \"none\"".into(),
         ));
     }
-    Ok(Some(AntiWindup {
-        gain,
-        tracking_time: time,
-    }))
+    Ok(Some(AntiWindup { gain }))
 }
 
 impl AntiWindup {
@@ -122,12 +116,8 @@ impl AntiWindup {
         let d_t = Vector3::new(delivered.0.x - demand.0.x, delivered.0.y - demand.0.y, 0.0);
         let d_r = Vector3::new(0.0, 0.0, delivered.1.z - demand.1.z);
         let trans = -(fr.q * d_t).component_mul(&self.gain[0]);
-        // W is invertible away from pitch ±90°, which a vessel holding position never nears;
-        // there the rotation's correction is left out rather than blown up.
-        let rot = match fr.w.transpose().try_inverse() {
-            Some(wit) => -(wit * d_r).component_mul(&self.gain[1]),
-            None => Vector3::zeros(),
-        };
+        // W = Pi_e(θ)⁻¹ Q, so W⁻ᵀ = Pi_e(θ)ᵀ Q in closed form (finite at every attitude).
+        let rot = -(so3::pi_e(&fr.euler).transpose() * (fr.q * d_r)).component_mul(&self.gain[1]);
         [trans, rot]
     }
 }
