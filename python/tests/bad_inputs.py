@@ -1635,7 +1635,7 @@ CATALOGUE += [
     Bad("adaptive save_at outside the span", sim(atol=1e-3, save_at=[5.0, 20.0]), E, ("save_at",)),
     Bad("adaptive settings given twice",
         lambda: phsplit.simulate(phsplit.Vessel.paper(), settings=phsplit.Settings(t_span=(0.0, 5.0)), atol=1e-3), E,
-        ("rtol, atol and h_max", "Settings")),
+        ("atol", "would not be used", "Settings")),
     Bad("simulate_many with adaptive steps",
         lambda: phsplit.simulate_many([{"vessel.mass": 6e6}], settings=phsplit.Settings(t_span=(0.0, 5.0), atol=1e-3)),
         E, ("simulate_many", "time grid", "rtol and atol")),
@@ -1654,4 +1654,107 @@ CATALOGUE += [
     Bad("adaptive h_max asking for too many steps", sim(atol=1e-3, h_max=1e-9), E, ("h_max", "at most")),
     Bad("adaptive first step longer than h_max", sim(atol=1e-3, h=1.0, h_max=0.1), E, ("h_max", "h <= h_max")),
     Bad("save_at as a 2-D array", sim(save_at=[[1.0, 2.0], [3.0, 4.0]]), E, ("save_at", "flat")),
+]
+
+
+# arguments of the public functions (phsplit._arguments), simulate_many, run_sweep, result files
+def _polar_plot(ds, path="cap.png"):
+    def run():
+        from phsplit.capability import polar_plot
+
+        with tempfile.TemporaryDirectory() as d:
+            return polar_plot(ds() if callable(ds) else ds, os.path.join(d, path))
+
+    return run
+
+
+def _not_a_capability_result():
+    import xarray as xr
+
+    return xr.Dataset({"energy": ("time", [1.0, 2.0])})
+
+
+def _run_sweep(**kw):
+    def run():
+        from phsplit.batch import Sweep, run_sweep
+
+        with tempfile.TemporaryDirectory() as d:
+            sweep = Sweep(settings=phsplit.Settings(t_span=(0.0, 1.0)), base=phsplit.Vessel.paper(), cases=_ONE)
+            return run_sweep(sweep, os.path.join(d, "store"), **kw)
+
+    return run
+
+
+def _open_text_as_result():
+    with tempfile.TemporaryDirectory() as d:
+        p = os.path.join(d, "notes.nc")
+        with open(p, "w") as f:
+            f.write("time,x\n0,1\n")
+        return phsplit.open_dataset(p)
+
+
+def _fluid_memory_damping(values):
+    def run():
+        from phsplit.radiation import with_fluid_memory
+        from phsplit.seakeeping import DEFAULT_DATASET
+
+        return with_fluid_memory(phsplit.Vessel.paper(), DEFAULT_DATASET, damping={"damping_translational": values})
+
+    return run
+
+
+_ONE = [{"vessel.mass": 6e6}]
+
+CATALOGUE += [
+    Bad("simulate with an unknown keyword", sim(t_spam=(0.0, 1.0)), E, ("t_spam", "did you mean t_span")),
+    Bad("simulate without a vessel", lambda: phsplit.simulate(), E, ("simulate()", "vessel")),
+    Bad("simulate with a step beside settings",
+        lambda: phsplit.simulate(phsplit.Vessel.paper(), h=0.1, settings=phsplit.Settings(t_span=(0.0, 1.0))), E,
+        ("h", "would not be used", "Settings")),
+    Bad("simulate with a method beside settings",
+        lambda: phsplit.simulate(phsplit.Vessel.paper(), method="sp2", settings=phsplit.Settings(t_span=(0.0, 1.0))),
+        E, ("method", "would not be used")),
+    Bad("rao with an unknown keyword", lambda: phsplit.rao(phsplit.Vessel.paper(), [0.5], 180.0, bogus=1), E,
+        ("rao()", "'bogus'", "heading")),
+    Bad("capability with an unknown keyword", lambda: phsplit.capability("dp-capability", direction=[0.0]), E,
+        ("capability()", "'direction'", "did you mean directions")),
+    Bad("with_fluid_memory with a negative damping", _fluid_memory_damping([-1.0, 0.0, 0.0]), E,
+        ("damping", "damping_translational")),
+    Bad("with_fluid_memory with an infinite damping", _fluid_memory_damping([float("inf"), 0.0, 0.0]), E,
+        ("damping", "damping_translational")),
+    Bad("simulate_many with no thread", lambda: phsplit.simulate_many(_ONE, max_workers=0, t_span=(0.0, 1.0)), E,
+        ("max_workers", "from 1 to")),
+    Bad("simulate_many with a negative thread count",
+        lambda: phsplit.simulate_many(_ONE, max_workers=-1, t_span=(0.0, 1.0)), E, ("max_workers", "from 1 to")),
+    Bad("simulate_many with a fractional thread count",
+        lambda: phsplit.simulate_many(_ONE, max_workers=1.5, t_span=(0.0, 1.0)), E, ("max_workers", "whole number")),
+    Bad("simulate_many with no case", lambda: phsplit.simulate_many([], t_span=(0.0, 1.0)), E, ("cases is empty",)),
+    Bad("simulate_many with events", lambda: phsplit.simulate_many(
+        _ONE, events=[phsplit.events.watch_circle(10.0)], t_span=(0.0, 1.0)), E, ("simulate_many", "events")),
+    Bad("simulate_many with save_at", lambda: phsplit.simulate_many(_ONE, save_at=[0.5], t_span=(0.0, 1.0)), E,
+        ("simulate_many", "save_at")),
+    Bad("simulate_many with a misspelt setting", lambda: phsplit.simulate_many(_ONE, t_spam=(0.0, 1.0)), E,
+        ("t_spam", "did you mean t_span")),
+    Bad("simulate_many with a step beside settings",
+        lambda: phsplit.simulate_many(_ONE, settings=phsplit.Settings(t_span=(0.0, 1.0)), h=0.1), E,
+        ("h", "would not be used")),
+    Bad("run_sweep with negative retries", _run_sweep(retries=-1), E, ("retries", "from 0 to 100")),
+    Bad("run_sweep with retries as text", _run_sweep(retries="3"), E, ("retries", "whole number")),
+    Bad("run_sweep with progress as text", _run_sweep(progress="yes"), E, ("progress", "True or False")),
+    Bad("polar plot of a result that is not a capability", _polar_plot(_not_a_capability_result), E,
+        ("polar_plot: ds", "not a capability result", "wind_speed_limit")),
+    Bad("polar plot of a list", _polar_plot([1, 2, 3]), E, ("polar_plot: ds", "xarray.Dataset")),
+    Bad("capability environment with a NaN", lambda: phsplit.capability(
+        "dp-capability", environment=[[0, 0, 0, 0, 0], [1, float("nan"), 1, 5, 0.1]]), E,
+        ("environment", "row 1", "nan", "wind speed")),
+    Bad("open_dataset of a text file", _open_text_as_result, E, ("notes.nc", "not a NetCDF file")),
+    Bad("open_dataset of a number", lambda: phsplit.open_dataset(42), E, ("path", "int")),
+    Bad("initial state of the wrong length", sim(initial=np.zeros(5)), E, ("initial", "27 numbers", "got 5")),
+    Bad("current faster than the component's range", scenario(
+        'vessel = "paper"\n[environment.current]\nspeed = 20\ndirection_towards = 45\n'), E,
+        ("environment.current.speed", "from 0 to 10 m/s")),
+    Bad("CLI: rerun of a file that is text", cli("rerun", "x.nc", files={"x.nc": b"t,x\n0,1\n"}), C,
+        ("x.nc", "not a NetCDF file")),
+    Bad("CLI: plot of a file that is text", cli("plot", "x.nc", files={"x.nc": b"t,x\n0,1\n"}), C,
+        ("x.nc", "not a NetCDF file")),
 ]

@@ -113,3 +113,27 @@ def test_the_cli_reports_the_worst_failure():
                        capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
     assert "worst single failure: thruster 3 lost" in r.stdout
+
+
+def test_a_failure_after_the_run_or_a_dropout_outside_it_is_reported(pipelay):
+    """A timed setting the run's span leaves without effect is said (SettingWarning), not dropped
+    silently; one inside the span is not warned about."""
+    sc, _ = pipelay
+    late = lose(sc, 1, at=50.0)
+    with pytest.warns(phsplit.SettingWarning, match=r"unit\[1\]\.lost_at = 50 s is after the run's end \(2 s\)"):
+        phsplit.simulate(late, (0.0, 2.0), 0.5)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", phsplit.SettingWarning)
+        phsplit.simulate(late, (0.0, 60.0), 0.5)  # lost within the run: no warning
+    obs = phsplit.load_scenario("dp-observer").vessel.to_dict()
+    obs["sensors"]["gnss_dropout"] = [[-50.0, -10.0], [1.0, 1.5]]
+    obs["sensors"]["gyro_dropout"] = [[30.0, 40.0]]
+    v = phsplit.Vessel.from_dict(obs)
+    with pytest.warns(phsplit.SettingWarning) as record:
+        phsplit.simulate(v, (0.0, 2.0), 0.5)
+    said = [str(w.message) for w in record if issubclass(w.category, phsplit.SettingWarning)]
+    assert any("gnss_dropout[0] = [-50, -10] s lies wholly before the run's start" in m for m in said), said
+    assert any("gyro_dropout[0] = [30, 40] s lies wholly after the run's end" in m for m in said), said
+    assert not any("gnss_dropout[1]" in m for m in said), said

@@ -27,6 +27,8 @@ sections and keys of a vessel file).
 from __future__ import annotations
 
 import concurrent.futures as futures
+import dataclasses
+import difflib
 import hashlib
 import itertools
 import json
@@ -45,6 +47,7 @@ from .settings import Settings, settings_to_toml
 from .sweepstore import (_coord_name, _stackable, _summary_row, _write_batch, _write_case,
                          done_cases, remove_temporaries, store_index, write_summary, write_sweep_file)
 from .vessel import Vessel
+from ._arguments import checked
 
 _PATH = re.compile(r"^([a-z_]+)((?:\.[a-z_]+|\[[0-9]+\])+)$")
 _SEGMENT = re.compile(r"\.([a-z_]+)|\[([0-9]+)\]")
@@ -111,6 +114,7 @@ def _resolve(d: dict, key: str) -> list[str | int]:
     return segs
 
 
+@checked
 def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
     """``base`` with parameters replaced: keys ``table.name``, ``table.name[i]`` or, for a
     matrix, ``table.name[i][j]`` of the vessel file (``vessel``, ``control``, ``initial``,
@@ -179,6 +183,15 @@ def summarize(vessel: Vessel, sol) -> dict[str, Any]:
     }
 
 
+def check_max_workers(where: str, max_workers: Any) -> None:
+    """A thread count: ``None`` (one per core) or a whole number from 1 to :data:`MAX_WORKERS`."""
+    if max_workers is not None and (isinstance(max_workers, bool) or not isinstance(max_workers, (int, np.integer))
+                                    or not 1 <= max_workers <= MAX_WORKERS):
+        raise _core.InvalidInputError(f"{where}: max_workers must be a whole number from 1 to {MAX_WORKERS} (or "
+                                      f"None: one per core), got {max_workers!r}")
+
+
+@checked
 def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = None,
                   settings: Settings | None = None, max_workers: int | None = None, **kw):
     """Run every case (a mapping of parameter paths to values) on a thread pool; the core releases
@@ -189,15 +202,34 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
     import xarray as xr
 
     base = base or Vessel.paper()
+    per_run = [k for k in ("events", "save_at", "initial", "running_max", "progress") if k in kw]
+    if per_run:
+        raise _core.InvalidInputError(
+            f"simulate_many does not take {per_run[0]}: its cases share one time grid and one summary; "
+            f"run phsplit.simulate(with_parameters(base, case), {per_run[0]}=...) for each case instead")
+    fields = [f.name for f in dataclasses.fields(Settings)]
+    unknown = [k for k in kw if k not in fields]
+    if unknown:
+        close = difflib.get_close_matches(unknown[0], fields, n=1)
+        hint = f" (did you mean {close[0]}?)" if close else ""
+        raise _core.InvalidInputError(f"simulate_many() has no argument {unknown[0]!r}{hint}: it takes cases, base, "
+                                      f"settings, max_workers and the settings {', '.join(fields)}")
+    if settings is not None and kw:
+        raise _core.InvalidInputError(f"settings=... gives every setting, so {', '.join(kw)} would not be used: give "
+                                      f"them in the Settings, or leave settings out")
     settings = settings or Settings(**kw)
     if not isinstance(settings, Settings):
         raise _core.InvalidInputError(f"settings must be a phsplit.Settings, got {type(settings).__name__}")
+    check_max_workers("simulate_many", max_workers)
     if settings.adaptive:
         raise _core.InvalidInputError(_ADAPTIVE_REFUSED.format(what="simulate_many"))
     if isinstance(cases, (str, bytes, Mapping)) or not isinstance(cases, Sequence) or not all(
             isinstance(c, Mapping) for c in cases):
         raise _core.InvalidInputError("cases must be a sequence of mappings {parameter path: value}, "
                                       f"got {type(cases).__name__}")
+    if not cases:
+        raise _core.InvalidInputError("cases is empty: give at least one mapping {parameter path: value} "
+                                      "({} runs the base vessel as it is)")
     keys = sorted({k for c in cases for k in c})
 
     def one(case):
@@ -285,6 +317,7 @@ SWEEP_KEYS = {"mode": "'grid' or 'random'", "samples": "number of random cases",
               "parameters": "table of parameter paths"}
 
 
+@checked
 def load_sweep(path: str) -> Sweep:
     """Read a sweep file: a scenario's ``[simulation]`` (and optional vessel) plus ``[sweep]``.
 
@@ -518,6 +551,7 @@ def check_cluster(scheduler: str | None = None, n_workers: int | None = None) ->
                                       f"{CONNECT_TIMEOUT:g} s (is a dask scheduler running there?)") from None
 
 
+@checked
 def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers: int | None = None,
               progress: bool = True, retries: int = 3) -> dict[str, Any]:
     """Run the missing cases of ``sweep`` on Dask and store them; returns counts and the summary
@@ -529,6 +563,14 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
     if not isinstance(sweep, Sweep):
         raise _core.InvalidInputError(f"sweep must be a phsplit.batch.Sweep, got {type(sweep).__name__}")
     check_cluster(scheduler, n_workers)
+    if isinstance(retries, bool) or not isinstance(retries, (int, np.integer)) or not 0 <= retries <= 100:
+        raise _core.InvalidInputError(f"retries must be a whole number from 0 to 100 (how often a lost case is tried "
+                                      f"again), got {retries!r}")
+    for name, flag in (("progress", progress),):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise _core.InvalidInputError(f"{name} must be True or False, got {flag!r}")
+    if not isinstance(store, (str, os.PathLike)):
+        raise _core.InvalidInputError(f"store must be a folder's path, got {type(store).__name__}")
     if os.path.exists(store) and not os.path.isdir(store):
         raise _core.InvalidInputError(f"the store {store!r} is a file, not a folder")
     ids = [sweep.case_id(i) for i in range(len(sweep.cases))]

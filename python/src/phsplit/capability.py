@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -22,6 +23,7 @@ import numpy as np
 
 from . import _core
 from .vessel import Vessel
+from ._arguments import checked
 
 #: The level-1 environment: Beaufort number, wind speed (m/s, 10 m above the sea, the top of
 #: the Beaufort class), significant wave height Hs (m), peak period Tp (s) and current speed
@@ -72,9 +74,13 @@ class Environment:
             t = np.asarray(table, dtype=float)
         except (TypeError, ValueError):
             _bad("environment", f"must be rows of 5 numbers (Beaufort, wind m/s, Hs m, Tp s, current m/s), got {table!r}")
-        if t.ndim != 2 or t.shape[1] != 5 or t.shape[0] < 2 or not np.all(np.isfinite(t)):
+        if t.ndim != 2 or t.shape[1] != 5 or t.shape[0] < 2:
             _bad("environment", f"must be at least 2 rows of 5 finite numbers (Beaufort, wind m/s, Hs m, Tp s, "
                  f"current m/s), got shape {t.shape}")
+        if not np.all(np.isfinite(t)):
+            i, j = np.argwhere(~np.isfinite(t))[0]
+            col = ("Beaufort", "wind speed", "Hs", "Tp", "current speed")[j]
+            _bad("environment", f"row {i} has {t[i, j]} as its {col} (column {j}): every entry must be a finite number")
         if np.any(np.diff(t[:, 1]) <= 0) or t[0, 1] != 0.0:
             _bad("environment", "the wind speeds must start at 0 and increase row by row")
         if np.any(t[:, 2:] < 0):
@@ -334,6 +340,7 @@ def _vessel_of(vessel: Any) -> Vessel:
     return vessel
 
 
+@checked
 def held(vessel: Vessel, demand: Sequence[float], lost: Sequence[int] = ()) -> dict:
     """The core's allocation of a demand (X, Y, N) on the vessel's thrusters without ``lost``:
     ``scale`` (1 when held), ``utilisation``, ``thrust``, ``angle``."""
@@ -356,6 +363,7 @@ def _feasible(vessel: Vessel, load: np.ndarray, lost: list[int]) -> bool:
     return held(vessel, -load, lost)["scale"] >= 1.0 - 1e-12
 
 
+@checked
 def capability(vessel: Any, directions: Any = None, failures: Any = "single",
                environment: Sequence[Sequence[float]] = LEVEL1, tolerance: float = 0.01):
     """The static DP capability of ``vessel`` (a :class:`phsplit.Vessel` with ``[wind]`` and
@@ -490,6 +498,7 @@ def capability(vessel: Any, directions: Any = None, failures: Any = "single",
     return cf.finish(ds, "phsplit DP capability (static, level 1)", "phsplit.capability")
 
 
+@checked
 def hold(vessel: Any, direction: float, wind_speed: float, lost: Sequence[int] = (),
          environment: Sequence[Sequence[float]] = LEVEL1, t_end: float = 1200.0, h: float = 0.5,
          method: str = "sp2"):
@@ -569,8 +578,32 @@ def hold(vessel: Any, direction: float, wind_speed: float, lost: Sequence[int] =
     return sol, np.hypot(*(sol.x[:, :2] - ref).T)
 
 
+def _check_capability_result(ds: Any) -> None:
+    """What :func:`polar_plot` reads of a :func:`capability` result, checked first."""
+    import xarray as xr
+
+    if not isinstance(ds, xr.Dataset):
+        _bad("polar_plot: ds", f"must be the xarray.Dataset that phsplit.capability returns, got {type(ds).__name__}")
+    need = {"wind_speed_limit": ("direction", "case"), "at_table_top": ("direction", "case")}
+    for name, dims in need.items():
+        if name not in ds or ds[name].dims != dims or "direction" not in ds.coords:
+            _bad("polar_plot: ds", f"is not a capability result (phsplit.capability): it needs {name} along "
+                 f"{dims} and the coordinate direction")
+    if ds.sizes["direction"] < 1 or ds.sizes["case"] < 1:
+        _bad("polar_plot: ds", "is a capability result with no direction or no case")
+
+
+@checked
 def polar_plot(ds, path: str, title: str | None = None) -> None:
     """Draw a capability dataset's wind speed limits as a polar plot (0 from ahead, clockwise)."""
+    _check_capability_result(ds)
+    if not isinstance(path, (str, os.PathLike)) or not str(path):
+        _bad("polar_plot: path", f"must be a file's path (e.g. capability.png), got {path!r}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder) or os.path.isdir(path):
+        _bad("polar_plot: path", f"{str(path)!r} is not a file in an existing folder")
+    if title is not None and not isinstance(title, str):
+        _bad("polar_plot: title", f"must be a string or None, got {type(title).__name__}")
     import matplotlib
 
     matplotlib.use("Agg", force=False)

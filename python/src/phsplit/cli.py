@@ -446,8 +446,10 @@ def _simulate(args) -> int:
     sols = []
     nc_file = None
     from .chunks import run_chunks
+    from .runner import warn_if_timed_settings_idle
     from .settings import settings_to_toml
 
+    warn_if_timed_settings_idle(sc.vessel, sc.settings.t_span, stacklevel=2)
     bar = _progress_bar(n)
     try:
         # Adaptive steps run as one call: a cut would restart the step-size controller.

@@ -22,6 +22,7 @@ import numpy as np
 from . import _core
 from .settings import Settings
 from .vessel import Vessel
+from ._arguments import checked
 
 #: A thruster counts as saturated when the largest |thrust| over its limit reaches this.
 SATURATED = 1.0 - 1e-9
@@ -60,6 +61,7 @@ def _reference(s, vessel: Vessel | None, reference: Sequence[float] | None) -> t
     return np.tile(r[:2], (n, 1)), np.full(n, r[2])
 
 
+@checked
 def footprint(s, vessel: Vessel | None = None, reference: Sequence[float] | None = None,
               after: float = 0.0) -> dict[str, float]:
     """The footprint of the run ``s`` from time ``after`` (s) on: the horizontal distance from the
@@ -162,6 +164,7 @@ def check_failure_study(vessel: Vessel, settings: Settings, at: float, at_name: 
     return units
 
 
+@checked
 def single_failures(vessel: Vessel, settings: Settings, at: float, max_workers: int | None = None) -> FailureStudy:
     """Run ``vessel`` with ``settings`` intact and with each of its thrusters lost at ``at`` (s) in
     turn (``thrusters.unit[i].lost_at``; a vessel that already loses one is refused), on a thread pool, and take

@@ -44,6 +44,7 @@ from . import _core, _provided
 from .runner import continue_from, solution_of
 from .settings import Settings
 from .vessel import Vessel
+from ._arguments import checked
 
 __all__ = ["Event", "EventHit", "watch_circle", "roll_beyond", "pitch_beyond", "energy_above"]
 
@@ -112,6 +113,7 @@ def _positive(name: str, what: str, v) -> float:
     return float(v)
 
 
+@checked
 def watch_circle(radius: float, direction: str = "leave", terminal: bool = True) -> Event:
     """The horizontal distance to the controller's set point crosses ``radius`` (m):
     ``direction="leave"`` (outward, the alarm), ``"enter"`` or ``"both"``. With a moving set
@@ -164,16 +166,19 @@ def _angle_event(which: int, label: str, limit_deg: float, terminal: bool) -> Ev
     return Event(f"{label}_{limit_deg:g}deg", g, "rise", terminal)
 
 
+@checked
 def roll_beyond(degrees: float, terminal: bool = True) -> Event:
     """``|roll|`` rises above ``degrees``."""
     return _angle_event(0, "roll_beyond", degrees, terminal)
 
 
+@checked
 def pitch_beyond(degrees: float, terminal: bool = True) -> Event:
     """``|pitch|`` rises above ``degrees``."""
     return _angle_event(1, "pitch_beyond", degrees, terminal)
 
 
+@checked
 def energy_above(joules: float, terminal: bool = True) -> Event:
     """The stored energy H rises above ``joules``."""
     e_max = _positive("energy_above", "energy (J)", joules)

@@ -16,6 +16,10 @@ from typing import Any
 from . import _core
 
 
+#: The first bytes of a NetCDF file: classic (CDF 1, 2, 5) or NetCDF-4 (HDF5).
+NETCDF_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+
+
 def open_dataset(path: str | os.PathLike[str], **kw: Any):
     """Open a phsplit result (NetCDF) as an ``xarray.Dataset``, lazily.
 
@@ -24,13 +28,26 @@ def open_dataset(path: str | os.PathLike[str], **kw: Any):
     written by phsplit raises :class:`phsplit.InvalidInputError`."""
     import xarray as xr
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise _core.InvalidInputError(f"path must be a file's path (a str or os.PathLike), got {type(path).__name__}")
     p = os.fspath(path)
+    if not isinstance(p, str):
+        p = os.fsdecode(p)
     if not os.path.isfile(p):
         raise _core.InvalidInputError(f"{p!r} does not exist (or is not a file)")
     try:
+        with open(p, "rb") as f:
+            head = f.read(8)
+    except OSError as e:
+        raise _core.InvalidInputError(f"{p!r} cannot be read: {e.strerror or e}") from None
+    if not head.startswith(NETCDF_SIGNATURES):
+        raise _core.InvalidInputError(f"{p!r} is not a NetCDF file (a phsplit result is NetCDF-4: it starts with "
+                                      f"HDF5's signature); give the .nc file a run wrote")
+    try:
         ds = xr.open_dataset(p, decode_times=False, **kw)
-    except (OSError, ValueError) as e:
-        raise _core.InvalidInputError(f"{p!r} is not a NetCDF file phsplit can read: {e}") from None
+    except (OSError, ValueError, RuntimeError) as e:
+        first = (str(e).strip().splitlines() or [type(e).__name__])[0][:200]
+        raise _core.InvalidInputError(f"{p!r} is not a NetCDF file phsplit can read: {first}") from None
     if "phsplit_version" not in ds.attrs:
         ds.close()
         raise _core.InvalidInputError(f"{p!r} was not written by phsplit (no phsplit_version attribute)")

@@ -54,6 +54,7 @@ import warnings
 import numpy as np
 
 from . import _core
+from ._arguments import checked
 
 DOFS = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 DRIFT_DOFS = ("Surge", "Sway", "Yaw")
@@ -535,6 +536,7 @@ def _vessel_params(vessel):
 
 # -- the loader ---------------------------------------------------------------------------------
 
+@checked
 def from_capytaine(ds, omega: float | None = None, symmetric: bool = False, *, checks: str | None = "refuse",
                    vessel=None, center_of_gravity=None) -> dict:
     """phsplit's tables from a Capytaine dataset (an ``xarray.Dataset`` or a path to its NetCDF

@@ -13,10 +13,12 @@ from __future__ import annotations
 import numpy as np
 
 from . import _core
+from ._arguments import checked
 
 __all__ = ["drive", "node_positions", "profile"]
 
 
+@checked
 def drive(vessel, times, tops) -> dict[str, np.ndarray]:
     """Drive ``vessel``'s dynamic pipe with its top at ``tops[i]`` (m, spatial, shape (n, 3)) at
     ``times[i]`` (s, increasing), from its static shape under ``tops[0]``, with the core's
@@ -50,6 +52,7 @@ def drive(vessel, times, tops) -> dict[str, np.ndarray]:
     return {k: np.asarray(v, dtype=np.float64) for k, v in out.items()}
 
 
+@checked
 def node_positions(ds) -> np.ndarray:
     """The pipe's node positions in a run's dataset (m, spatial), shape (time, node, 3): the
     top (node 0, on the hang-off point), the free nodes, and the anchor (the last)."""
@@ -62,6 +65,7 @@ def node_positions(ds) -> np.ndarray:
     return np.concatenate([top[:, None, :], free, anchor[:, None, :]], axis=1)
 
 
+@checked
 def profile(ds) -> tuple[np.ndarray, np.ndarray]:
     """The pipe's profile in its vertical plane: the horizontal distance of each node from the
     anchor and its height (m), each of shape (time, node)."""

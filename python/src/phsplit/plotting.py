@@ -7,8 +7,10 @@ import numpy as np
 
 from . import _core
 from .files import publish, temporary_beside
+from ._arguments import checked
 
 
+@checked
 def plot_positions(sol, path: str, reference: dict | None = None, title: str | None = None) -> None:
     """x, y, z, roll, pitch, yaw against time (the paper's Fig. 2), written atomically to ``path``."""
     import matplotlib
@@ -90,6 +92,7 @@ def check_plottable(ds, where: str = "the result") -> None:
                                           "with its [control] set point)") from None
 
 
+@checked
 def plot_dp(ds, path: str, watch_circle: float | None = None, title: str | None = None) -> None:
     """The main figure of a DP run, from a result dataset (``Solution.to_xarray()`` or a file
     opened with ``phsplit.open_dataset``), written atomically to ``path``:
@@ -150,6 +153,7 @@ def _legend_outside(ax, ncol: int = 2, fontsize: float = 7.5, handles=None) -> N
                   ncol=ncol, fontsize=fontsize, borderaxespad=0.0, frameon=False)
 
 
+@checked
 def dp_figure(ds, watch_circle: float | None = None, title: str | None = None):
     """The figure of :func:`plot_dp` (a matplotlib Figure; the caller closes it)."""
     import tomllib
@@ -319,6 +323,7 @@ def dp_figure(ds, watch_circle: float | None = None, title: str | None = None):
     return fig
 
 
+@checked
 def plot_pipe(ds, path: str, snapshots: int = 8, title: str | None = None) -> None:
     """The dynamic pipe's figure (docs/model.md §5.18), from a result dataset, written
     atomically to ``path``: its profile in its vertical plane at ``snapshots`` times and its
@@ -333,6 +338,7 @@ def plot_pipe(ds, path: str, snapshots: int = 8, title: str | None = None) -> No
         plt.close(fig)
 
 
+@checked
 def pipe_figure(ds, snapshots: int = 8, title: str | None = None):
     """The figure of :func:`plot_pipe`, not yet written."""
     import matplotlib.pyplot as plt
@@ -369,6 +375,7 @@ def pipe_figure(ds, snapshots: int = 8, title: str | None = None):
     return fig
 
 
+@checked
 def plot_rao(ds, path: str, title: str | None = None) -> None:
     """An RAO dataset of :func:`phsplit.rao` (one heading, or several along ``heading`` as
     ``phsplit rao`` writes it), written atomically to ``path``: per DOF the amplitude per unit

@@ -50,6 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _core
+from ._arguments import checked
 
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 
@@ -170,6 +171,7 @@ def transfer(blocks, S, omega) -> np.ndarray:
     return out
 
 
+@checked
 def retardation_data(dataset, *, symmetric: bool = True, checks: str = "refuse", vessel=None,
                      a_inf: str = "dataset"):
     """``(ω, K, A∞, source, loaded)``: the dataset's frequencies, ``K(iω) = B(ω) + iω(A(ω) − A∞)``
@@ -411,6 +413,7 @@ def _kinds(spec, gname: str, size: int) -> list[str]:
     return list(spec)
 
 
+@checked
 def fluid_memory(dataset, *, symmetric: bool = True, checks: str = "refuse", vessel=None, blocks=None,
                  a_inf: str = "dataset", coupling_tolerance: float = 1e-3, refine: bool = True,
                  name: str = "radiation", rank_tolerance: float = 1e-9, starts: int = 6) -> FluidMemory:
@@ -516,6 +519,7 @@ def _added_mass_is_a_models(vessel) -> bool:
     return False
 
 
+@checked
 def with_fluid_memory(vessel, dataset, *, damping=None, memory: FluidMemory | None = None, symmetric: bool = True,
                       checks: str = "refuse", **fit):
     """The vessel (a ``phsplit.Vessel``) with Cummins' fluid memory of a Capytaine dataset: its
@@ -552,6 +556,14 @@ def with_fluid_memory(vessel, dataset, *, damping=None, memory: FluidMemory | No
                 ok = False
             if not ok:
                 raise _err(f"damping[{k!r}] must be 3 numbers (kg/s or kg m^2/s), got {x!r}")
+        # The values checked by the core on the vessel they make, before the fit.
+        trial = vessel.to_dict()
+        for k, x in damping.items():
+            trial["vessel"][k] = [float(c) for c in x]
+        try:
+            Vessel.from_dict(trial)
+        except _core.InvalidInputError as e:
+            raise _err(f"damping: {e}") from None
     if "added_mass" in d["vessel"] and np.any(np.asarray(d["vessel"]["added_mass"], float) != 0.0) \
             and not _added_mass_is_a_models(vessel):
         raise _err("the vessel gives vessel.added_mass, which the fluid memory replaces by the dataset's "

@@ -33,6 +33,7 @@ from .files import open_dataset
 from .settings import Settings
 from .sweepstore import open_sweep, sweep_case
 from .vessel import Vessel
+from ._arguments import checked
 
 #: The CF finishing of a dataset (:func:`phsplit.cf.finish`), under its earlier name.
 cf_finish = cf.finish
@@ -53,6 +54,7 @@ def _damaged(key: str, why: str) -> _core.InvalidInputError:
     return _core.InvalidInputError(f"the file's {key} attribute is damaged: {why}; it cannot be rerun")
 
 
+@checked
 def vessel_of(ds) -> Vessel:
     """The vessel a result was computed with."""
     text = _need(ds, "phsplit_vessel")
@@ -69,6 +71,7 @@ _SETTINGS_TYPES = {"t_span": list, "h": (int, float), "method": str, "outer": st
                    "linear_flow": str, "ledger": bool}
 
 
+@checked
 def settings_of(ds) -> Settings:
     """The settings a result was computed with (checked as a run's are)."""
     text = _need(ds, "phsplit_settings")
@@ -161,6 +164,7 @@ def check_record(ds) -> tuple[Vessel, Settings, np.ndarray, list[int]]:
     return vessel, settings, y0, chunks
 
 
+@checked
 def rerun(source, progress: bool = False):
     """Rerun the simulation a phsplit file (a path or an open dataset) records, with the same
     calls, and return its result as a dataset laid out like the file. A run the file records as
@@ -191,6 +195,7 @@ def rerun(source, progress: bool = False):
     return out
 
 
+@checked
 def compare(a, b) -> list[tuple[str, float]]:
     """The variables of ``a`` whose values differ from ``b``'s (NaN equal to NaN), with the
     largest absolute difference; ``[]`` when every number agrees to the last bit. Variables

@@ -5,6 +5,8 @@ energy created by negative sub-steps."""
 from __future__ import annotations
 
 import math
+import os
+import sys
 import warnings
 
 import numpy as np
@@ -14,6 +16,17 @@ from .settings import Settings
 from .solution import Ledger, Solution
 from .vessel import Vessel
 
+def user_stacklevel() -> int:
+    """The ``stacklevel`` that points a warning at the user's code: the first frame, counted from
+    the caller of ``warnings.warn``, outside the package (however many of phsplit's own calls and
+    argument checks lie between)."""
+    here = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    frame, level = sys._getframe(1), 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(here):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
 class StepSizeWarning(UserWarning):
     """The step is longer than half the vessel's shortest natural period: the run stays
     passive and bounded (for the splitting methods) but cannot resolve that motion."""
@@ -21,7 +34,8 @@ class StepSizeWarning(UserWarning):
 
 class SettingWarning(UserWarning):
     """A run setting could not act as asked and the run says what it did instead (the exact
-    flow S2 on a vessel whose S2 has a forcing part, which Gauss collocation integrates)."""
+    flow S2 on a vessel whose S2 has a forcing part, which Gauss collocation integrates; a
+    thruster failure or a sensor dropout outside the run's span)."""
 
 
 class PassivityWarning(UserWarning):
@@ -54,7 +68,7 @@ def _warn_if_out_of_range(sol, stacklevel: int) -> None:
             warnings.warn(ModelRangeWarning(
                 f"{name} reached {a[i]:.0f} degrees (t = {float(sol.t[i]):g} s), beyond the {limit:g} degrees to which the "
                 f"metacentric restoring (GM sin θ) holds: the run follows the model, not the hull's own righting "
-                f"arm there (docs/model.md §2.3)"), stacklevel=stacklevel)
+                f"arm there (docs/model.md §2.3)"), stacklevel=user_stacklevel())
 
 
 def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray, stacklevel: int) -> None:
@@ -74,7 +88,33 @@ def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray, st
         f"interval(s), first ending at t = {raw['t'][i]:g} s ({d[i - 1]:.3e} J dissipated). Its passivity needs "
         f"the Prop. 2.5 condition sigma_max/sigma_min <= {info[key]:.3g} for H^(1/2) D H^(1/2); this vessel's "
         "D is only semidefinite (sigma_min = 0), so the condition does not hold. Use a smaller h, or "
-        "'sp2'/'lie', whose positive steps are passive for any h (Prop. 2.2)."), stacklevel=stacklevel)
+        "'sp2'/'lie', whose positive steps are passive for any h (Prop. 2.2)."), stacklevel=user_stacklevel())
+
+
+def warn_if_timed_settings_idle(vessel: Vessel, t_span: tuple[float, float], stacklevel: int) -> None:
+    """A :class:`SettingWarning` for each timed setting of the vessel that this run's span leaves
+    without effect: a thruster lost (``lost_at``) after the run's end, a sensor dropout wholly
+    before its start or after its end. The vessel is the same for any span (a run cut into parts
+    sees each part's), so the whole run's span is judged here, where the user gives it."""
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    d = vessel.to_dict()
+    for i, unit in enumerate((d.get("thrusters") or {}).get("unit") or []):
+        at = unit.get("lost_at") if isinstance(unit, dict) else None
+        if isinstance(at, (int, float)) and not isinstance(at, bool) and at > t1:
+            warnings.warn(SettingWarning(
+                f"thrusters.unit[{i}].lost_at = {at:g} s is after the run's end ({t1:g} s): the thruster is not lost "
+                f"in this run"), stacklevel=user_stacklevel())
+    for key in ("gnss_dropout", "gyro_dropout"):
+        rows = (d.get("sensors") or {}).get(key) or []
+        for k, row in enumerate(rows):
+            if isinstance(row, (list, tuple)) and len(row) == 2 and all(
+                    isinstance(v, (int, float)) and not isinstance(v, bool) for v in row):
+                a, b = float(row[0]), float(row[1])
+                if b <= t0 or a >= t1:
+                    where = "before the run's start" if b <= t0 else "after the run's end"
+                    warnings.warn(SettingWarning(
+                        f"sensors.{key}[{k}] = [{a:g}, {b:g}] s lies wholly {where} (the run spans [{t0:g}, {t1:g}] "
+                        f"s): the sensor does not drop out in this run"), stacklevel=user_stacklevel())
 
 
 def _warn_if_step_too_long(vessel: Vessel, y0: np.ndarray | None, settings: Settings, stacklevel: int) -> None:
@@ -98,7 +138,7 @@ def _warn_if_step_too_long(vessel: Vessel, y0: np.ndarray | None, settings: Sett
             f"periods {', '.join(f'{p:.3g}' for p in periods[:4])} s): the run cannot resolve that motion. "
             f"The splitting methods stay bounded and passive at such steps; take h < {0.5 * periods[0]:.3g} s to "
             f"resolve it, and about a tenth of the period ({0.1 * periods[0]:.2g} s) to follow it accurately."),
-            stacklevel=stacklevel)
+            stacklevel=user_stacklevel())
 
 
 
@@ -140,7 +180,7 @@ def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, ort
         warnings.warn(SettingWarning(
             "linear_flow = 'exact' cannot act on this vessel: its flow S2 has a forcing part (a load that is "
             "not affine in the state, or that depends on time), which Gauss collocation of the method's order "
-            "integrates; the run used linear_flow = 'gauss' (docs/model.md §3.7)"), stacklevel=stacklevel)
+            "integrates; the run used linear_flow = 'gauss' (docs/model.md §3.7)"), stacklevel=user_stacklevel())
     if used["ledger"] and info["kind"] == "splitting" and not info["all_positive"] and len(e) > 1:
         _warn_if_energy_created(raw, info, used["outer"], e, stacklevel)
     mass, inertia = vessel._body()

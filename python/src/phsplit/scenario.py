@@ -65,6 +65,7 @@ from . import _core
 from . import hydro, sea
 from .settings import Settings
 from .vessel import PRESET_ALIASES, Vessel, presets
+from ._arguments import checked
 
 
 @dataclass
@@ -419,6 +420,10 @@ def in_radians(table: dict[str, Any], name: str, key: str, path: str) -> dict[st
     return table
 
 
+#: The current component's largest speed (m/s; forces/current.rs).
+MAX_CURRENT_SPEED = 10.0
+
+
 def current_table(table: dict[str, Any], where: str) -> dict[str, Any]:
     """A ``[current]`` table with the current given by ``speed`` (m/s) and a direction
     (``direction``/``direction_towards``: where it goes, ``direction_from``: where it comes from;
@@ -435,8 +440,10 @@ def current_table(table: dict[str, Any], where: str) -> dict[str, Any]:
     speed = table.get("speed")
     if speed is None:
         raise _core.InvalidInputError(f"{where}: a direction needs the current's speed (m/s): add speed = ...")
-    if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not math.isfinite(speed) or speed < 0:
-        raise _core.InvalidInputError(f"{where}.speed must be a number >= 0 (m/s), got {speed!r}")
+    if isinstance(speed, bool) or not isinstance(speed, (int, float)) or not math.isfinite(speed) or not (
+            0 <= speed <= MAX_CURRENT_SPEED):
+        raise _core.InvalidInputError(f"{where}.speed must be a number from 0 to {MAX_CURRENT_SPEED:g} m/s (the "
+                                      f"current component's range; a sea's currents stay below 3 m/s), got {speed!r}")
     if not any(k in table for k in sea.DIRECTION_KEYS):
         raise _core.InvalidInputError(f"{where}: speed needs a direction (degrees): direction_towards = ... "
                                       "(where the current goes) or direction_from = ... (where it comes from)")
@@ -458,6 +465,7 @@ def vessel_named(name: str, base_dir: str = ".") -> Vessel:
     return Vessel.from_toml(p)
 
 
+@checked
 def load(path: str | os.PathLike[str], vessel: str | None = None) -> Scenario:
     """Read and validate a scenario file, or a shipped scenario by name (``"pipelay"``);
     ``vessel`` replaces its vessel (see :func:`from_dict`)."""

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _core
+from ._arguments import checked
 
 SPECTRA = ("jonswap", "pierson-moskowitz")
 
@@ -193,12 +194,14 @@ def _cos2s_draw(rng, s: float, n: int) -> np.ndarray:
     return np.interp(rng.uniform(0.0, 1.0, n), cdf, th)
 
 
+@checked
 def regular(amplitude: float, omega: float, direction: float = 0.0, phase: float = 0.0) -> dict[str, list[float]]:
     """One regular wave: amplitude (m), frequency (rad/s), direction (degrees), phase (rad)."""
     return {"frequencies": [float(omega)], "amplitudes": [float(amplitude)], "phases": [float(phase)],
             "directions": [float(direction)]}
 
 
+@checked
 def sea_state(table: dict) -> SeaState:
     """A :class:`SeaState` from a scenario's ``[environment.waves]`` keys (unknown keys named;
     the direction by ``direction``/``direction_towards`` or ``direction_from``, degrees)."""
@@ -230,6 +233,7 @@ def sea_state(table: dict) -> SeaState:
 WIND_SPECTRA = ("harris", "npd")
 
 
+@checked
 def harris(f, speed: float, drag: float = 0.002, length: float = 1800.0):
     """The Harris gust spectrum (m² s⁻² per Hz) at frequencies ``f`` (Hz) for the mean speed
     ``speed`` at 10 m: ``S(f) = 4 κ L U / (2 + (f L / U)²)^(5/6)`` with the surface drag
@@ -241,6 +245,7 @@ def harris(f, speed: float, drag: float = 0.002, length: float = 1800.0):
     return 4.0 * drag * length * speed / (2.0 + (f * length / speed) ** 2) ** (5.0 / 6.0)
 
 
+@checked
 def npd(f, speed: float, height: float = 10.0):
     """The NPD (Frøya) gust spectrum (m² s⁻² per Hz) at frequencies ``f`` (Hz) for the 1-hour
     mean speed ``speed`` at 10 m, at the height ``height`` (m):
@@ -324,6 +329,7 @@ class Wind:
         return out
 
 
+@checked
 def wind(table: dict) -> tuple[dict, dict]:
     """A scenario's ``[environment.wind]``: the realised wind keys, and the rest (the windage
     and coefficients), which go to the vessel's ``[wind]`` table unchanged."""
@@ -392,6 +398,7 @@ BLENDERMANN = {
 }
 
 
+@checked
 def blendermann(ship_type: str, frontal_area: float, lateral_area: float, length: float,
                 centroid_x: float = 0.0, step: float = 10.0) -> dict:
     """The ``[wind]`` coefficient table (``angles``, ``cx``, ``cy``, ``cn``, in phsplit's

@@ -26,6 +26,7 @@ import warnings
 import numpy as np
 
 from . import _core, cf, hydro, radiation, sea
+from ._arguments import checked
 
 DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 #: The shipped box of the paper's vessel (dp-weather's dataset).
@@ -51,6 +52,7 @@ def _skew(r) -> np.ndarray:
     return np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
 
 
+@checked
 def linear_model(vessel):
     """``(M, D, C)`` of a vessel about its body origin, without its added mass: the rigid body's
     mass matrix with the centre of gravity at ``r_g`` (Fossen 2021, eq. 3.44:
@@ -92,6 +94,7 @@ def linear_model(vessel):
     return M, D, C
 
 
+@checked
 def roll_damping(vessel) -> tuple[float, float]:
     """``(B₁, B₂)`` of the vessel's ``[roll_damping]`` (N m s, N m s²; zeros without one), ``B₁``
     from ``critical_fraction`` as the core computes it: ``2ζ√(M₄₄ C₄₄)``, ``M₄₄`` the roll entry
@@ -117,6 +120,7 @@ def roll_damping(vessel) -> tuple[float, float]:
     return 2.0 * zeta * math.sqrt(m44 * c44), b2
 
 
+@checked
 def waves_table(vessel, dataset=DEFAULT_DATASET) -> dict:
     """The ``[waves]`` transfer functions of the dataset about the vessel's origin (first order
     only: no drift)."""
@@ -125,6 +129,7 @@ def waves_table(vessel, dataset=DEFAULT_DATASET) -> dict:
     return {k: out["waves"][k] for k in ("rao_frequencies", "rao_directions", "force_rao_real", "force_rao_imag")}
 
 
+@checked
 def frequency_rao(vessel, omega: float, heading: float, dataset=DEFAULT_DATASET, *, data=None,
                   amplitude: float | None = None) -> np.ndarray:
     """``[−ω²(M + A(ω)) + iω(B(ω) + D) + C]⁻¹ F(ω)`` for a wave of unit amplitude (complex, the
@@ -188,6 +193,7 @@ def _fit(t, sig, omega):
     return complex(c[0], -c[1])
 
 
+@checked
 def time_rao(vessel, waves, omega: float, heading: float, *, amplitude: float = 0.1, h: float = 0.5,
              t_end: float = 600.0, periods: float = 10.0, method: str = "sp4", dofs=DOFS):
     """The complex amplitudes per unit wave amplitude (a dict by DOF: m/m, rad/m) of ``vessel``
@@ -249,6 +255,7 @@ def _positive(name, x):
     return float(x)
 
 
+@checked
 def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *, amplitude: float = 0.1,
         dataset=None, fluid_memory=True, h: float = 0.5, t_end: float = 600.0, periods: float = 10.0,
         method: str = "sp4", check_only: bool = False):

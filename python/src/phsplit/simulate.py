@@ -9,21 +9,54 @@ are re-exported.
 """
 from __future__ import annotations
 
+import functools
+import inspect
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
 from . import _core, _provided
 from .events import run_with_outputs
-from .runner import ModelRangeWarning, PassivityWarning, SettingWarning, StepSizeWarning, run
+from .runner import ModelRangeWarning, PassivityWarning, SettingWarning, StepSizeWarning, run, warn_if_timed_settings_idle
 from .settings import Settings, settings_to_toml
 from .solution import Ledger, Solution
 from .vessel import Vessel, presets
+from ._arguments import checked
 
 __all__ = ["simulate", "Vessel", "Solution", "Ledger", "Settings", "presets", "settings_to_toml", "ModelRangeWarning",
            "StepSizeWarning", "PassivityWarning", "SettingWarning"]
 
 
+#: The arguments of :func:`simulate` that are settings (fields of :class:`Settings`).
+_SETTING_ARGUMENTS = ("t_span", "h", "method", "control_start", "outer", "save_every", "ledger", "project_invariants",
+                      "linear_flow", "rtol", "atol", "h_max")
+
+
+def _settings_alone(f):
+    """``simulate`` refusing a settings argument given beside ``settings=`` (which gives every
+    setting, so the argument would not be used), told from the call's own arguments."""
+    sig = inspect.signature(f)
+
+    @functools.wraps(f)
+    def call(*args, **kw):
+        try:
+            given = sig.bind(*args, **kw).arguments
+        except TypeError:
+            return f(*args, **kw)
+        if given.get("settings") is not None:
+            both = [n for n in _SETTING_ARGUMENTS if n in given
+                    and not (n in ("rtol", "atol", "h_max") and given[n] is None)]
+            if both:
+                raise _core.InvalidInputError(
+                    f"settings=... gives every setting, so {', '.join(both)} would not be used: give them in the "
+                    f"Settings (dataclasses.replace(settings, {both[0]}=...)), or leave settings out")
+        return f(*args, **kw)
+
+    return call
+
+
+@checked
+@_settings_alone
 def simulate(
     vessel: Vessel,
     t_span: tuple[float, float] = Settings.t_span,
@@ -70,8 +103,8 @@ def simulate(
     elsewhere and with adaptive steps (measured: docs/how-to,
     "The linear flow S2"); ``Solution.meta["s2_solver"]`` says which ran. An initial
     attitude that is not a rotation is rejected unless ``orthonormalize=True`` asks for its
-    projection to the nearest rotation. ``settings`` (a :class:`Settings`) replaces all the
-    settings arguments at once.
+    projection to the nearest rotation. ``settings`` (a :class:`Settings`) gives all the
+    settings at once; with it, a settings argument given as well is refused (it would not be used).
 
     Every setting is validated by the core; a bad one raises ``InvalidInputError`` naming it.
     A span that is not a whole number of steps ends with one shorter step, at ``t1``.
@@ -111,11 +144,10 @@ def simulate(
         settings = Settings(t_span=t_span, h=h, method=method, control_start=control_start, outer=outer,
                             save_every=save_every, linear_flow=linear_flow, ledger=ledger,
                             project_invariants=project_invariants, rtol=rtol, atol=atol, h_max=h_max)
-    elif rtol is not None or atol is not None or h_max is not None:
-        raise _core.InvalidInputError("rtol, atol and h_max are settings: with settings=..., give them in the "
-                                      "Settings (dataclasses.replace(settings, rtol=...))")
     elif not isinstance(settings, Settings):
         raise _core.InvalidInputError(f"settings must be a phsplit.Settings, got {type(settings).__name__}")
+    if not _continuing:
+        warn_if_timed_settings_idle(vessel, settings.checked()["t_span"], stacklevel=4)
     if isinstance(settings.save_every, float):
         raise _core.InvalidInputError(f"save_every must be an integer >= 1, got {settings.save_every!r}")
     if initial is None:

@@ -17,6 +17,8 @@ import numpy as np
 
 from . import _core, cf
 from .files import open_dataset, publish, temporary_beside
+from ._arguments import checked
+
 
 def _coord_name(key: str) -> str:
     return key.replace(".", "_").replace("[", "_").replace("]", "")
@@ -241,6 +243,7 @@ def write_summary(store: str, ids: list[str], known: dict[str, dict] | None = No
     return path
 
 
+@checked
 def sweep_case(store: str | os.PathLike[str], case_id: str):
     """One case of a sweep store as the dataset of its own run (loaded into memory), whether it
     is stored in a file of its own or in a batch file: the batch's variables at the case, and its
@@ -268,6 +271,7 @@ def sweep_case(store: str | os.PathLike[str], case_id: str):
     return one
 
 
+@checked
 def open_sweep(store: str | os.PathLike[str]):
     """The cases of a sweep store (``phsplit sweep``) as one dataset with a ``case`` dimension,
     opened lazily through Dask, in the order of the sweep file, from files of one case

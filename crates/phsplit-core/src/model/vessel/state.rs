@@ -207,7 +207,7 @@ impl VesselState {
         let with_memory = base + 1 + 2 * actuators;
         if y.len() != base && (actuators == 0 || y.len() != with_memory) {
             let mut what = format!(
-                "a state is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x)"
+                "the initial state (initial) is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x)"
             );
             if own > 0 {
                 what += &format!(", or {base} with the components' {own} own states");
@@ -251,13 +251,13 @@ impl VesselState {
     pub fn from_slice_checked(y: &[f64], orthonormalize: bool) -> Result<Self> {
         if y.len() != STATE_DIM {
             return Err(Error::InvalidInput(format!(
-                "a state is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x), got {}",
+                "the initial state (initial) is a flat vector of {STATE_DIM} numbers (p, m, Q column-major, mu, x, phi_th, phi_x), got {}",
                 y.len()
             )));
         }
         if let Some(i) = y.iter().position(|v| !v.is_finite()) {
             return Err(Error::InvalidInput(format!(
-                "the initial state must be finite; entry {i} ({}) is {}",
+                "the initial state (initial) must be finite; entry {i} ({}) is {}",
                 LAYOUT
                     .iter()
                     .find(|(_, o, l)| i >= *o && i < o + l)
