@@ -58,6 +58,18 @@ SCENARIO_LINES = [
     "[current]", "velocity = [0.5, 0.0, 0.0]", "[environment.current]", "direction_towards = 90.0",
     "[environment.waves]", "hs = 2.0", "hs = -1.0", "tp = 8.0", "direction = 270.0", "symmetric = \"no\"",
     "[environment.wind]", "frontal_area = 200.0",
+    # the DP system, adaptive steps, the dynamic pipe, roll damping and subsystems
+    'feedback = "observer"', 'feedback = "true"', 'anti_windup = "back_calculation"', 'anti_windup = "yes"',
+    "tracking_time = 60.0", "tracking_time = -1.0", "lost_at = 100.0", "lost_at = nan", "lost_at = 1e20",
+    "[observer]", "wave_frequency = 0.8", "wave_frequency = 80.0", "damping = [3.5e4, 1.2e5, 3.2e8]",
+    "damping = [-1.0, 0.0, 0.0]", "notch_damping = 0.05", "cutoff_frequency = 0.5", "initial_estimate = [1e6, 0.0, 0.0]",
+    "[sensors]", "gnss_rate = 1.0", "gnss_rate = 0.0", "gyro_rate = 10.0", "gnss_noise = -0.1", "seed = -3",
+    "gnss_dropout = [[10.0, 20.0]]", "gnss_dropout = [[20.0, 10.0]]", "gyro_bias = 7.0",
+    "rtol = 1e-4", "atol = 1e-20", "h_max = 0.0", "h_max = 5.0",
+    'model = "lumped_mass"', 'model = "fem"', "segments = 20", "segments = 0", "length = 400.0",
+    "bending_stiffness = 3.79e7", "bending_stiffness = -1.0",
+    "[roll_damping]", "linear = 1e6", "quadratic = -5.0", "fraction_of_critical = 0.05", "fraction_of_critical = 3.0",
+    "[port_hamiltonian]", 'name = "tank"', "J = [[0.0]]", "R = [[-1.0]]", "Q = [[1.0]]", "x0 = [0.0, 1.0]",
 ]
 
 
