@@ -187,6 +187,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "thrust_rate": ("N/s", "none", "fastest change of thrust, > 0"),
         "turn_rate": ("degrees/s", "none", "azimuth: fastest turn, > 0"),
         "lost_at": ("s", "none", "the time the thruster is lost: from then it delivers nothing and the allocation redistributes the demand (§5.8); within ±1e9 s, at or before the start: lost from the start"),
+        "stuck_at": ("s", "none", "the time the thruster fails as set: from then it keeps the thrust and angle it delivered at the end of the step before, and the allocation redistributes the rest of the demand (§5.8); within ±1e9 s; not with lost_at"),
     },
     "waves": {
         "frequencies": ("rad/s", REQ, "ω_k of the sea state's components, > 0 (realised by `phsplit.sea`; §5.9)"),

@@ -1758,3 +1758,41 @@ CATALOGUE += [
     Bad("CLI: plot of a file that is text", cli("plot", "x.nc", files={"x.nc": b"t,x\n0,1\n"}), C,
         ("x.nc", "not a NetCDF file")),
 ]
+
+
+# a thruster that fails as set (thrusters.unit[i].stuck_at) and the failure study's modes
+def _pipelay_stuck(*stuck: int, value: object = 300.0, lost: bool = False) -> Callable[[], object]:
+    def make():
+        from phsplit import scenario as scn
+
+        d = scn.load("pipelay").vessel.to_dict()
+        for i in stuck:
+            d["thrusters"]["unit"][i]["stuck_at"] = value
+            if lost:
+                d["thrusters"]["unit"][i]["lost_at"] = value
+        return phsplit.Vessel.from_dict(d)
+    return make
+
+
+def _study_of_stuck():
+    from phsplit import dp, scenario as scn
+
+    sc = scn.load("pipelay")
+    return dp.single_failures(_pipelay_stuck(1)(), sc.settings, at=600.0)
+
+
+CATALOGUE += [
+    Bad("thruster both lost and stuck", _pipelay_stuck(1, lost=True), E,
+        ("thrusters.unit[1]", "lost_at", "stuck_at", "not both")),
+    Bad("thruster stuck at a time that is a word", _pipelay_stuck(1, value="noon"), P,
+        ("thrusters.unit[1].stuck_at", "number")),
+    Bad("thruster stuck at a NaN time", _pipelay_stuck(1, value=float("nan")), E, ("thrusters.unit[1].stuck_at",)),
+    Bad("thruster stuck beyond a billion seconds", _pipelay_stuck(1, value=2e9), E, ("thrusters.unit[1].stuck_at",)),
+    Bad("thrusters stuck that leave no surge", _pipelay_stuck(2, 3), E,
+        ("stuck_at", "2 (stuck), 3 (stuck)", "surge, sway and yaw")),
+    Bad("single failures in an unknown mode", _failures(mode="jammed"), E, ("single_failures", "mode", "lost, stuck, both")),
+    Bad("single failures of a vessel that already sticks a thruster", _study_of_stuck, E,
+        ("thrusters.unit[1].stuck_at", "remove stuck_at")),
+    Bad("CLI: failures in an unknown mode", cli("failures", "pipelay", "--at", "5", "--mode", "jammed"), C,
+        ("--mode", "jammed")),
+]

@@ -137,3 +137,49 @@ def test_a_failure_after_the_run_or_a_dropout_outside_it_is_reported(pipelay):
     assert any("gnss_dropout[0] = [-50, -10] s lies wholly before the run's start" in m for m in said), said
     assert any("gyro_dropout[0] = [30, 40] s lies wholly after the run's end" in m for m in said), said
     assert not any("gnss_dropout[1]" in m for m in said), said
+
+
+def test_a_stuck_thruster_keeps_its_thrust_and_the_others_take_the_rest(pipelay):
+    """The stern azimuth stuck at 300 s (fails as set): from then it keeps the thrust and angle it
+    delivered at the end of the step before (saved every step here), reports itself out of the
+    allocation, and the others deliver the rest of the demand, tau - tau_stuck, as the
+    least-norm split over them (computed again here with numpy); inside the capacity the total
+    is the demand. The run completes, the ledger closes, and the vessel carries the memory."""
+    sc, st = pipelay
+    d = sc.vessel.to_dict()
+    d["thrusters"]["unit"][3]["stuck_at"] = AT
+    v = phsplit.Vessel.from_dict(d)
+    s = st.run(v)
+    assert s.status == "completed"
+    o = s.outputs
+    after = s.t >= AT
+    before = int(np.argmax(after)) - 1
+    thrust, angle = o["thruster3_thrust"][2], o["thruster3_angle"][2]
+    assert thrust[before] > 1e5  # it was working
+    np.testing.assert_array_equal(thrust[after], thrust[before])
+    np.testing.assert_array_equal(angle[after], angle[before])
+    assert np.all(o["thruster3_available"][2][after] == 0.0) and np.all(o["thruster3_available"][2][~after] == 1.0)
+    # the demand moves on after the failure, so the stuck thruster is no longer what it asks
+    tau_c = np.array([[o[f"commanded_{q}"][2][k] for q in ("surge", "sway", "yaw")] for k in range(len(s.t))])
+    units = d["thrusters"]["unit"]
+    a = np.radians(angle[before])
+    fs = thrust[before] * np.array([np.cos(a), np.sin(a)])
+    x3, y3 = units[3]["position"][:2]
+    tau_s = np.array([fs[0], fs[1], x3 * fs[1] - y3 * fs[0]])
+    checked = 0
+    for k in np.flatnonzero(after)[::50]:
+        want = least_norm(units, {3}, tau_c[k] - tau_s)
+        if max(np.linalg.norm(want[i]) / units[i]["max_thrust"] for i in range(3)) >= 1.0:
+            continue  # saturated: scaled, not this check
+        for i in range(3):
+            got = abs(o[f"thruster{i}_thrust"][2][k])
+            assert abs(got - np.linalg.norm(want[i])) < 1e-6 * max(1.0, np.linalg.norm(want[i])), (k, i)
+        for q, dof in enumerate(("surge", "sway", "yaw")):
+            assert abs(o[f"delivered_{dof}"][2][k] - tau_c[k, q]) <= 1e-9 * max(1.0, abs(tau_c[k, q]))
+        checked += 1
+    assert checked >= 5
+    assert np.max(s.ledger.relative_residual()) < 1e-9
+    assert len(s.state(len(s.t) - 1)) > 27  # the thrusters' memory travels with the state
+    with pytest.raises(phsplit.InvalidInputError, match=r"unit\[3\]: give lost_at .* or stuck_at .*not both"):
+        d["thrusters"]["unit"][3]["lost_at"] = AT
+        phsplit.Vessel.from_dict(d)

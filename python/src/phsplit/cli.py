@@ -205,18 +205,24 @@ def _parser() -> argparse.ArgumentParser:
     cp.add_argument("--no-plot", action="store_true", help="skip the PNG")
     fa = sub.add_parser(
         "failures",
-        help="the worst single thruster failure: the scenario run intact and with each thruster lost at a time",
-        description="Runs the scenario intact and with each of its thrusters lost at --at (thrusters.unit[i].lost_at: "
-        "from then the allocation redistributes the demand over the others) and prints, per case, the footprint "
+        help="the worst single thruster failure: the scenario run intact and with each thruster failed at a time",
+        description="Runs the scenario intact and with each of its thrusters failed at --at (--mode lost: "
+        "thrusters.unit[i].lost_at, it delivers nothing; --mode stuck: stuck_at, it keeps its thrust and angle; "
+        "--mode both: each way; from then the allocation redistributes the demand over the others) and prints, "
+        "per case, the footprint "
         "after the failure (largest and RMS excursion from the set point, heading deviation, thruster utilisation, "
         "time saturated) and the worst case (docs/how-to/dp-failures.md).",
-        epilog="examples:\n  phsplit failures pipelay --at 600\n  phsplit failures pipelay --at 600 --t-end 1800",
+        epilog="examples:\n  phsplit failures pipelay --at 600\n  phsplit failures pipelay --at 600 --t-end 1800\n"
+        "  phsplit failures pipelay --at 600 --mode both",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     fa.add_argument("scenario", help="scenario TOML file or shipped scenario name whose vessel has [thrusters]")
     fa.add_argument("--at", type=float, required=True, help="time of the failure, s, within the run")
     fa.add_argument("--t-end", type=float, help="override the end time, s")
     fa.add_argument("--vessel", help="use this vessel (a file or a shipped vessel's name) in the scenario")
+    fa.add_argument("--mode", choices=["lost", "stuck", "both"], default="lost",
+                    help="how each thruster fails: lost (delivers nothing), stuck (keeps its thrust and angle), "
+                    "or both (default: lost)")
     ra = sub.add_parser(
         "rao",
         help="motion RAOs in regular waves, time domain against the frequency domain of a Capytaine dataset",
@@ -826,9 +832,11 @@ def _failures(args) -> int:
         n = len(check_failure_study(sc.vessel, st, args.at, at_name="--at"))
     except phsplit.InvalidInputError as e:
         raise UsageError(str(e).removeprefix("single_failures: ")) from None
-    print(f"{sc.name}: {n + 1} runs on [{st.t_span[0]:g}, {st.t_span[1]:g}] s, each thruster lost in turn at "
+    ways = {"lost": "lost", "stuck": "stuck", "both": "lost and stuck"}[args.mode]
+    runs = 1 + n * (2 if args.mode == "both" else 1)
+    print(f"{sc.name}: {runs} runs on [{st.t_span[0]:g}, {st.t_span[1]:g}] s, each thruster {ways} in turn at "
           f"t = {args.at:g} s", flush=True)
-    study = single_failures(sc.vessel, st, at=args.at)
+    study = single_failures(sc.vessel, st, at=args.at, mode=args.mode)
     print(study.table())
     w = study.worst
     if w is None:

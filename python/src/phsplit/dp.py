@@ -106,7 +106,8 @@ def footprint(s, vessel: Vessel | None = None, reference: Sequence[float] | None
 @dataclass
 class FailureStudy:
     """The cases of :func:`single_failures`: ``rows`` (one dict per case: ``case``, ``lost``
-    (the thruster's index, or None), ``status``, ``error`` and the :func:`footprint` after the
+    (the failed thruster's index, or None), ``mode`` (``"lost"``, ``"stuck"`` or None),
+    ``status``, ``error`` and the :func:`footprint` after the
     failure) and ``worst``, the completed failure case with the largest excursion."""
 
     at: float
@@ -148,11 +149,12 @@ def check_failure_study(vessel: Vessel, settings: Settings, at: float, at_name: 
     t0, t1 = settings.t_span
     if isinstance(at, bool) or not isinstance(at, (int, float)) or not (t0 <= at < t1):
         raise _core.InvalidInputError(f"{at_name} must be a time within the run's t_span [{t0:g}, {t1:g}) s, got {at!r}")
-    already = [i for i, u in enumerate(units) if "lost_at" in u]
+    already = [(i, k) for i, u in enumerate(units) for k in ("lost_at", "stuck_at") if k in u]
     if already:
+        i, k = already[0]
         raise _core.InvalidInputError(
-            f"single_failures: thrusters.unit[{already[0]}].lost_at = {units[already[0]]['lost_at']:g} s is set; "
-            "the study loses each thruster in turn at its own time (at): remove lost_at from the vessel")
+            f"single_failures: thrusters.unit[{i}].{k} = {units[i][k]:g} s is set; "
+            f"the study fails each thruster in turn at its own time (at): remove {k} from the vessel")
     # the footprint after the failure needs two saved states from `at` on
     h, every = settings.h, settings.save_every
     n_after = math.floor((t1 - at) / (h * every) + 1e-9)
@@ -164,24 +166,36 @@ def check_failure_study(vessel: Vessel, settings: Settings, at: float, at_name: 
     return units
 
 
+#: How :func:`single_failures` fails each thruster: the key it sets, and how a case is named.
+FAILURE_MODES = {"lost": "lost_at", "stuck": "stuck_at"}
+
+
 @checked
-def single_failures(vessel: Vessel, settings: Settings, at: float, max_workers: int | None = None) -> FailureStudy:
-    """Run ``vessel`` with ``settings`` intact and with each of its thrusters lost at ``at`` (s) in
-    turn (``thrusters.unit[i].lost_at``; a vessel that already loses one is refused), on a thread pool, and take
-    each case's :func:`footprint` from ``at`` on. A case the allocation cannot take (the thrusters
-    left cannot produce surge, sway and yaw) or whose run fails is listed with its error."""
+def single_failures(vessel: Vessel, settings: Settings, at: float, max_workers: int | None = None,
+                    mode: str = "lost") -> FailureStudy:
+    """Run ``vessel`` with ``settings`` intact and with each of its thrusters failed at ``at`` (s) in
+    turn, on a thread pool, and take each case's :func:`footprint` from ``at`` on. ``mode``:
+    ``"lost"`` (``thrusters.unit[i].lost_at``: it delivers nothing), ``"stuck"``
+    (``stuck_at``: it fails as set, keeping its thrust and angle) or ``"both"`` (each thruster
+    each way). A vessel that already fails one is refused. A case the allocation cannot take
+    (the thrusters left cannot produce surge, sway and yaw) or whose run fails is listed with
+    its error."""
+    modes = list(FAILURE_MODES) if mode == "both" else [mode]
+    if not isinstance(mode, str) or any(m not in FAILURE_MODES for m in modes):
+        raise _core.InvalidInputError(f"single_failures: mode must be one of lost, stuck, both, got {mode!r}")
     units = check_failure_study(vessel, settings, at)
     if max_workers is not None and (isinstance(max_workers, bool) or not isinstance(max_workers, (int, np.integer))
                                     or max_workers < 1):
         raise _core.InvalidInputError(f"single_failures: max_workers must be a whole number ≥ 1 (or None: one per "
                                       f"core), got {max_workers!r}")
 
-    def one(lost):
-        case = "intact" if lost is None else f"thruster {lost} lost"
-        row = {"case": case, "lost": lost, "status": "invalid", "error": ""}
+    def one(failure):
+        lost, how = failure
+        case = "intact" if lost is None else f"thruster {lost} {how}"
+        row = {"case": case, "lost": lost, "mode": how, "status": "invalid", "error": ""}
         dd = vessel.to_dict()
         if lost is not None:
-            dd["thrusters"]["unit"][lost]["lost_at"] = float(at)
+            dd["thrusters"]["unit"][lost][FAILURE_MODES[how]] = float(at)
         try:
             v = Vessel.from_dict(dd)
         except (_core.InvalidInputError, _core.ScenarioParseError) as e:
@@ -194,7 +208,7 @@ def single_failures(vessel: Vessel, settings: Settings, at: float, max_workers: 
             row.update(footprint(s, vessel=v, after=at))
         return row
 
-    cases = [None] + list(range(len(units)))
+    cases = [(None, None)] + [(i, m) for m in modes for i in range(len(units))]
     with futures.ThreadPoolExecutor(max_workers=max_workers or os.cpu_count() or 2) as pool:
         rows = list(pool.map(one, cases))
     return FailureStudy(at=float(at), rows=rows)

@@ -376,7 +376,7 @@ impl Force for Pid {
                 out.push(Output::new(
                     format!("thruster{i}_available"),
                     "1",
-                    format!("whether thruster {i} delivers (0 once lost: its lost_at)"),
+                    format!("whether thruster {i} answers the allocation (0 once lost or stuck: its lost_at, stuck_at)"),
                     f64::from(u8::from(all.available(i, t))),
                 ));
                 out.push(Output::new(
@@ -495,7 +495,7 @@ impl Force for Pid {
     }
     fn actuators(&self) -> usize {
         match &self.thrusters {
-            Some(th) if th.rate_limited() => th.units.len(),
+            Some(th) if th.has_memory() => th.units.len(),
             _ => 0,
         }
     }

@@ -17,6 +17,15 @@
 //!     once, and the allocation distributes the demand over the thrusters left (from the first
 //!     stage of flow S2 at or after that time; reported as `thruster<i>_available`). The
 //!     thrusters left must still produce surge, sway and yaw independently.
+//!   - `stuck_at` (s, optional; not with `lost_at`): a thruster that fails as set (its pitch,
+//!     speed or azimuth control frozen: the failure such a control is designed to, since IMO
+//!     MSC/Circ.645 §3.3.4 requires that it not send the thruster to uncontrolled full
+//!     thrust): from that time the thruster keeps the thrust and angle it delivered at the end
+//!     of the last step before, and the allocation distributes the rest of the demand,
+//!     `τ − τ_stuck`, over the thrusters left. The vessel
+//!     then carries what the thrusters deliver in its state ([`Actuators`], as for rate
+//!     limits); a thruster stuck at or before the run's start keeps what the start's memory
+//!     gives it, which is no thrust.
 //!
 //! **Allocation** (T. A. Johansen and T. I. Fossen, "Control allocation — a survey",
 //! *Automatica* 49 (2013) 1087–1103, §2.2; Fossen, *Handbook of Marine Craft Hydrodynamics and
@@ -103,8 +112,12 @@ pub struct Thrusters {
     vars: Vec<(usize, Vector2<f64>, Vector3<f64>)>,
     /// Each unit's variables, `vars[start..end]` (contiguous).
     ranges: Vec<(usize, usize)>,
-    /// From each time a thruster is lost (its `lost_at`), the allocation without it and those
-    /// lost before: each unit keeps its index, a lost one has no variables and delivers nothing.
+    /// Whether each unit is stuck (its `stuck_at` passed): it has no variables and delivers
+    /// what the memory holds ([`Self::delivered`]).
+    stuck: Vec<bool>,
+    /// From each time a thruster fails (its `lost_at` or `stuck_at`), the allocation without it
+    /// and those failed before: each unit keeps its index; a lost one has no variables and
+    /// delivers nothing, a stuck one keeps its memory.
     after: Vec<(f64, Thrusters)>,
 }
 
@@ -158,6 +171,7 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
     }
     let mut units = Vec::with_capacity(list.len());
     let mut lost_at = Vec::with_capacity(list.len());
+    let mut stuck_at = Vec::with_capacity(list.len());
     let mut recorded = Vec::with_capacity(list.len());
     for (i, item) in list.iter().enumerate() {
         let name = format!("thrusters.unit[{i}]");
@@ -171,12 +185,22 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
         wrapped.insert(name.clone(), Value::Table(t.clone()));
         let mut sub = Params::from_table(wrapped);
         let unit = read_unit(&mut sub, &name, length, beam)?;
-        lost_at.push(sub.opt_f64(
-            &name,
-            "lost_at",
-            "s",
-            Range::Physical(&crate::model::vessel::params::physical::TIME),
-        )?);
+        let when = |sub: &mut Params, key: &str| {
+            sub.opt_f64(
+                &name,
+                key,
+                "s",
+                Range::Physical(&crate::model::vessel::params::physical::TIME),
+            )
+        };
+        let (lost, stuck) = (when(&mut sub, "lost_at")?, when(&mut sub, "stuck_at")?);
+        if lost.is_some() && stuck.is_some() {
+            return Err(Error::InvalidInput(format!(
+                "{name}: give lost_at (the thruster delivers nothing) or stuck_at (it keeps its last thrust and angle), not both: a thruster fails one way"
+            )));
+        }
+        lost_at.push(lost);
+        stuck_at.push(stuck);
         // A key this kind does not read is refused, with the keys it does read.
         let out = sub.finish()?;
         if let Some(v) = out.get(&name) {
@@ -187,14 +211,17 @@ pub fn read(p: &mut Params) -> Result<Option<Thrusters>> {
     p.record_value(T, "unit", Value::Array(recorded));
     let limited = units
         .iter()
-        .any(|u| u.thrust_rate.is_some() || u.turn_rate.is_some());
+        .any(|u| u.thrust_rate.is_some() || u.turn_rate.is_some())
+        || stuck_at.iter().any(Option::is_some);
     if limited && units.len() > MAX_ACTUATORS {
         return Err(Error::InvalidInput(format!(
-            "thrusters.unit has {} thrusters; with rate limits (thrust_rate, turn_rate) at most {MAX_ACTUATORS} are kept (their memory is part of the state): remove the rate limits or merge thrusters",
+            "thrusters.unit has {} thrusters; with rate limits (thrust_rate, turn_rate) or a stuck_at at most {MAX_ACTUATORS} are kept (their memory is part of the state): remove them or merge thrusters",
             units.len()
         )));
     }
-    Thrusters::new(units)?.with_losses(&lost_at).map(Some)
+    Thrusters::new(units)?
+        .with_failures(&lost_at, &stuck_at)
+        .map(Some)
 }
 
 fn read_unit(p: &mut Params, s: &str, length: f64, beam: f64) -> Result<Thruster> {
@@ -268,16 +295,19 @@ impl Thrusters {
     /// sway and yaw independently (`B` of rank 3).
     pub fn new(units: Vec<Thruster>) -> Result<Self> {
         let intact = vec![false; units.len()];
-        Self::without(units, &intact)
+        Self::without(units, &intact, &intact)
     }
 
     /// The allocation of `units` without those marked `lost` (which keep their index and
-    /// deliver nothing, at once: no rate limit holds them).
-    fn without(mut units: Vec<Thruster>, lost: &[bool]) -> Result<Self> {
+    /// deliver nothing, at once: no rate limit holds them) or `stuck` (which keep their memory).
+    fn without(mut units: Vec<Thruster>, lost: &[bool], stuck: &[bool]) -> Result<Self> {
         let mut cols: Vec<(usize, Vector2<f64>, Vector3<f64>, f64)> = Vec::new();
         for (i, u) in units.iter_mut().enumerate() {
             if lost[i] {
                 (u.thrust_rate, u.turn_rate) = (None, None);
+                continue;
+            }
+            if stuck[i] {
                 continue;
             }
             let dirs: Vec<Vector2<f64>> = match u.kind {
@@ -318,25 +348,39 @@ impl Thrusters {
             units,
             vars,
             ranges,
+            stuck: stuck.to_vec(),
             after: Vec::new(),
         })
     }
 
-    /// With the losses of `lost_at` (one per unit, s; `None`: never lost): from each such time
-    /// the allocation redistributes the demand over the thrusters left.
-    pub fn with_losses(mut self, lost_at: &[Option<f64>]) -> Result<Self> {
-        let mut times: Vec<f64> = lost_at.iter().flatten().copied().collect();
+    /// With the losses of `lost_at` (one per unit, s; `None`: never lost).
+    pub fn with_losses(self, lost_at: &[Option<f64>]) -> Result<Self> {
+        self.with_failures(lost_at, &vec![None; lost_at.len()])
+    }
+
+    /// With the failures of `lost_at` and `stuck_at` (one each per unit, s; `None`: no such
+    /// failure): from each such time the allocation redistributes the demand (less what the
+    /// stuck thrusters deliver) over the thrusters left.
+    pub fn with_failures(
+        mut self,
+        lost_at: &[Option<f64>],
+        stuck_at: &[Option<f64>],
+    ) -> Result<Self> {
+        let mut times: Vec<f64> = lost_at.iter().chain(stuck_at).flatten().copied().collect();
         times.sort_by(f64::total_cmp);
         times.dedup();
+        let by = |at: &[Option<f64>], tk: f64| -> Vec<bool> {
+            at.iter().map(|l| l.is_some_and(|t| t <= tk)).collect()
+        };
         for tk in times {
-            let lost: Vec<bool> = lost_at.iter().map(|l| l.is_some_and(|t| t <= tk)).collect();
-            let left = Self::without(self.units.clone(), &lost).map_err(|e| {
+            let (lost, stuck) = (by(lost_at, tk), by(stuck_at, tk));
+            let left = Self::without(self.units.clone(), &lost, &stuck).map_err(|e| {
                 let gone: Vec<String> = (0..lost.len())
-                    .filter(|i| lost[*i])
-                    .map(|i| i.to_string())
+                    .filter(|i| lost[*i] || stuck[*i])
+                    .map(|i| if lost[i] { i.to_string() } else { format!("{i} (stuck)") })
                     .collect();
                 Error::InvalidInput(format!(
-                    "thrusters.unit[*].lost_at: with thruster(s) {} lost from t = {tk} s, {e}",
+                    "thrusters.unit[*].lost_at/stuck_at: with thruster(s) {} failed from t = {tk} s, {e}",
                     gone.join(", ")
                 ))
             })?;
@@ -345,7 +389,13 @@ impl Thrusters {
         Ok(self)
     }
 
-    /// The first time after `t` at which a thruster is lost.
+    /// Whether a thruster ever sticks: the vessel then keeps what the thrusters deliver in its
+    /// state.
+    pub fn may_stick(&self) -> bool {
+        self.after.iter().any(|(_, th)| th.stuck.iter().any(|s| *s))
+    }
+
+    /// The first time after `t` at which a thruster is lost or sticks.
     pub fn next_loss(&self, t: f64) -> Option<f64> {
         self.after.iter().map(|(tk, _)| *tk).find(|&tk| tk > t)
     }
@@ -359,7 +409,7 @@ impl Thrusters {
             .map_or(self, |(_, th)| th)
     }
 
-    /// Whether thruster `i` still delivers at time `t`.
+    /// Whether thruster `i` still answers the allocation at time `t` (not lost, not stuck).
     pub fn available(&self, i: usize, t: f64) -> bool {
         let th = self.at(t);
         th.ranges[i].0 < th.ranges[i].1

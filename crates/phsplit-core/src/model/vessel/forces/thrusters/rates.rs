@@ -18,6 +18,25 @@ impl Thrusters {
             .any(|u| u.thrust_rate.is_some() || u.turn_rate.is_some())
     }
 
+    /// Whether the vessel keeps what the thrusters deliver in its state: with rate limits, or
+    /// with a thruster that sticks (`stuck_at`).
+    pub fn has_memory(&self) -> bool {
+        self.rate_limited() || self.may_stick()
+    }
+
+    /// What the stuck thrusters of memory `mem` deliver in surge, sway and yaw (body frame).
+    fn stuck_part(&self, mem: &Actuators) -> Vector3<f64> {
+        let mut tau = Vector3::zeros();
+        for (i, u) in self.units.iter().enumerate() {
+            if self.stuck[i] {
+                let (s, c) = mem.angle[i].sin_cos();
+                let (fx, fy) = (mem.thrust[i] * c, mem.thrust[i] * s);
+                tau += Vector3::new(fx, fy, u.position.x * fy - u.position.y * fx);
+            }
+        }
+        tau
+    }
+
     /// Thruster `i`'s command for the demand `tau` whose allocation is scaled by `c`
     /// ([`Thrusters::scale`]): its thrust, its angle (an azimuth commanded no thrust keeps the
     /// angle `keep`) and its force in the body's x–y plane.
@@ -62,8 +81,13 @@ impl Thrusters {
     /// fixed point sees a continuous forcing, even where a command reverses. A command within
     /// reach is delivered exactly. An azimuth's new angle is its force's direction; one that
     /// delivers no force turns towards its command by at most `turn_rate · |dt|`.
+    ///
+    /// A stuck thruster keeps its memory; the others are commanded the rest of the demand,
+    /// `tau` less what the stuck ones deliver.
     pub fn delivered(&self, tau: &Vector3<f64>, mem: &Actuators, dt: f64) -> Actuators {
         let dt = dt.abs();
+        let rest = tau - self.stuck_part(mem);
+        let tau = &rest;
         let c = self.scale(tau);
         let mut out = Actuators {
             n: self.units.len(),
@@ -71,6 +95,10 @@ impl Thrusters {
             ..Actuators::default()
         };
         for (i, u) in self.units.iter().enumerate() {
+            if self.stuck[i] {
+                (out.thrust[i], out.angle[i]) = (mem.thrust[i], mem.angle[i]);
+                continue;
+            }
             let (thrust, angle, cmd) = self.unit_command(i, tau, c, mem.angle[i]);
             (out.thrust[i], out.angle[i]) = match u.kind {
                 Kind::Azimuth => {
@@ -191,7 +219,7 @@ impl Thrusters {
         Allocation {
             commanded: *tau,
             delivered: Vector3::new(force.x, force.y, moment.z),
-            scale: self.scale(tau),
+            scale: self.scale(&(tau - self.stuck_part(mem))),
             thrust: d.thrust[..n].to_vec(),
             angle: d.angle[..n].to_vec(),
             utilisation: util,
