@@ -80,6 +80,9 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "gnss_dropout": ("s", "none", "rows `[start, end]` in time order: the receiver delivers nothing in between"),
         "gyro_dropout": ("s", "none", "rows `[start, end]`: the gyro delivers nothing in between"),
         "seed": ("-", "0", "whole number ≥ 0: the noise of sample k is drawn from (seed, sensor, k)"),
+        "gnss_antenna": ("m", "[0, 0, 0]", "the GNSS antenna, body frame from the body origin, each within ±250: its fix is referred to the origin with the MRU's roll and pitch and the gyro's heading"),
+        "mru_noise": ("rad", "0", "standard deviation of the MRU's roll and pitch noise, in [0, 0.1] (read at each GNSS sample; needs gnss_antenna)"),
+        "mru_bias": ("rad", "[0, 0]", "constant bias of the MRU's roll and pitch, each within ±0.1 (needs gnss_antenna)"),
     },
     "external": {
         "force": ("N", "[0, 0, 0]", "constant force (§5.4)"),

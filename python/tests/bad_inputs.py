@@ -1796,3 +1796,18 @@ CATALOGUE += [
     Bad("CLI: failures in an unknown mode", cli("failures", "pipelay", "--at", "5", "--mode", "jammed"), C,
         ("--mode", "jammed")),
 ]
+
+CATALOGUE += [
+    # the GNSS antenna's lever arm and the MRU that refers the fix to the body origin
+    Bad("GNSS antenna 900 m up", _sensors(_RATES + "gnss_antenna = [0.0, 0.0, -900.0]\n"), E,
+        ("sensors.gnss_antenna", "250")),
+    Bad("GNSS antenna of two numbers", _sensors(_RATES + "gnss_antenna = [1.0, 2.0]\n"), E, ("sensors.gnss_antenna",)),
+    Bad("MRU bias of one number", _sensors(_RATES + "gnss_antenna = [0.0, 0.0, -20.0]\nmru_bias = [0.01]\n"), E,
+        ("sensors.mru_bias must be 2 numbers",)),
+    Bad("MRU bias in degrees", _sensors(_RATES + "gnss_antenna = [0.0, 0.0, -20.0]\nmru_bias = [5.7, 0.0]\n"), E,
+        ("sensors.mru_bias", "0.1")),
+    Bad("negative MRU noise", _sensors(_RATES + "gnss_antenna = [0.0, 0.0, -20.0]\nmru_noise = -0.01\n"), E,
+        ("sensors.mru_noise",)),
+    Bad("MRU errors without an antenna offset", _sensors(_RATES + "mru_noise = 0.001\n"), E,
+        ("mru_noise", "with the antenna at the origin nothing reads it", "gnss_antenna")),
+]

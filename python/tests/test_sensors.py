@@ -190,3 +190,37 @@ def test_the_shipped_dp_observer_scenario_sits_off_by_the_gnss_bias():
     bias = np.array(v.to_dict()["sensors"]["gnss_bias"])
     np.testing.assert_allclose(off, bias, atol=0.05)
     assert np.max(s.ledger.relative_residual()) < 1e-10
+
+
+ARM = [-10.0, 4.0, -25.0]   # m, body frame: the antenna 25 m up a mast aft of the origin (z down)
+
+
+def test_the_gnss_antenna_is_referred_to_the_origin_with_the_mru_and_the_gyro():
+    """``gnss_antenna``: the receiver measures ``x + Q r_a``; the DP system subtracts ``R(Θ~) r_a``
+    with the MRU's roll and pitch and the gyro's heading. With a perfect MRU and gyro the fix is
+    the origin's to round-off, although the arm alone moves the antenna by metres as the vessel
+    rolls; with biased ones it is off by exactly ``Q r_a - R(Θ~) r_a``, computed again here with
+    scipy's rotations from the run's attitude."""
+    from scipy.spatial.transform import Rotation
+
+    base = {"gnss_rate": 1.0, "gyro_rate": 1.0, "gnss_antenna": ARM}
+    initial = {"euler": [0.1, -0.05, 0.1]}   # rolled and trimmed: the vessel rolls and pitches freely
+    arm = np.array(ARM)
+    for extra in ({}, {"mru_bias": [0.01, -0.02], "gyro_bias": 0.004}):
+        v = vessel({**base, **extra}, external=None, initial=initial)
+        s = phsplit.simulate(v, (0.0, 60.0), 0.5, "sp4", control_start=None)
+        at = np.flatnonzero((np.abs(s.t - np.round(s.t)) < 1e-9) & (s.t > 0))
+        mx, my = own(s, v, "measured_x")[at], own(s, v, "measured_y")[at]
+        zyx = Rotation.from_matrix(s.Q[at]).as_euler("ZYX")           # (psi, theta, phi)
+        b = extra.get("mru_bias", [0.0, 0.0])
+        measured = Rotation.from_euler("ZYX", np.column_stack(
+            [zyx[:, 0] + extra.get("gyro_bias", 0.0), zyx[:, 1] + b[1], zyx[:, 2] + b[0]]))
+        want = s.x[at] + s.Q[at] @ arm - measured.apply(arm)
+        np.testing.assert_allclose(mx, want[:, 0], rtol=0, atol=1e-9)
+        np.testing.assert_allclose(my, want[:, 1], rtol=0, atol=1e-9)
+        if not extra:
+            np.testing.assert_allclose(mx, s.x[at, 0], rtol=0, atol=1e-9)
+            heading_only = Rotation.from_euler("z", zyx[:, :1]).apply(arm)
+            assert np.max(np.hypot(*(s.Q[at] @ arm - heading_only)[:, :2].T)) > 1.0   # the arm matters
+        else:
+            assert np.max(np.abs(mx - s.x[at, 0])) > 0.1   # the MRU's and gyro's errors times the arm

@@ -517,9 +517,9 @@ impl Observer {
     }
 
     /// The sensors' samples at the end of a step at time `t` (and where a run starts).
-    pub fn end_step(&self, t: f64, pos: &Vector3<f64>, psi: f64, x: &mut [f64]) {
+    pub fn end_step(&self, t: f64, pos: &Vector3<f64>, q: &Matrix3<f64>, x: &mut [f64]) {
         if let Some(sn) = &self.sensors {
-            sn.update(t, pos, psi, &mut x[N..]);
+            sn.update(t, pos, q, crate::lie::so3::euler_and_w(q).0.z, &mut x[N..]);
         }
     }
 

@@ -537,7 +537,7 @@ impl Force for Pid {
     }
     fn own_end_step(&self, t: f64, s: &VesselState, x: &mut [f64]) {
         if let Some(o) = &self.observer {
-            o.end_step(t, &s.x, crate::lie::so3::euler_and_w(&s.q).0.z, x);
+            o.end_step(t, &s.x, &s.q, x);
         }
     }
     fn held_states(&self) -> Option<std::ops::Range<usize>> {
