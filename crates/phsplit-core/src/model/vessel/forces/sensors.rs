@@ -16,7 +16,7 @@
 //! system refers the fix to the body origin with the attitude it measures, `x̂ = p_a − R(Θ̃) r_a`,
 //! `Θ̃` the motion reference unit's (MRU's) roll and pitch and the gyro's last heading (the
 //! standard lever-arm correction of a DP system's position references: Sørensen, Annu. Rev.
-//! Control 35 (2011) §3; IMCA M 141 on MRU and gyro use in DP). The MRU is read at each GNSS
+//! Control 35 (2011) §3). The MRU is read at each GNSS
 //! sample (an MRU samples at 10–100 Hz, far above a GNSS's 1–10 Hz) with `mru_noise` (rad,
 //! standard deviation of roll and of pitch; default 0) and `mru_bias` (2 numbers, rad, roll and
 //! pitch; default 0). A perfect MRU and gyro cancel the lever arm exactly; what is left is the
