@@ -262,9 +262,9 @@ def reference_end(memory):
 
 @pytest.mark.parametrize("method,order", [("sp2", 2), ("sp4", 4)])
 def test_orders_with_the_memory_against_the_independent_model(memory, reference_end, method, order):
-    """The paper's vessel with the whole 36-state memory and A_inf, the controller on from a kicked
+    """The paper's vessel with the whole 40-state memory and A_inf, the controller on from a kicked
     start for 2 s: the largest relative error of p, m, x and the memory's states at the end, at
-    h = 1/2 ... 1/32 s, falls with the method's order (measured: slopes 1.994 and 3.996)."""
+    h = 1/2 ... 1/32 s, falls with the method's order (measured: slopes 1.995 and 3.996)."""
     vessel, fm = memory
     states = [f"radiation_{x}" for x in fm.table["states"]]
     want = np.concatenate([reference_end[0:6], reference_end[18:21], reference_end[27:]])

@@ -20,11 +20,11 @@ PAGE = {
     (90.0, 0.68): {"heave": (1.014, 1.008), "roll": (2.16, 2.159)},
     (90.0, 1.04): {"heave": (0.8407, 0.8349), "roll": (0.1154, 0.1464)},
     (90.0, 1.40): {"heave": (0.1431, 0.1431), "roll": (0.3654, 0.369)},
-    (180.0, 0.44): {"heave": (0.9163, 0.9182), "pitch": (1.075, 1.074)},
-    (180.0, 0.56): {"heave": (0.7827, 0.7801), "pitch": (1.609, 1.605)},
-    (180.0, 0.68): {"heave": (0.5504, 0.5471), "pitch": (2.046, 2.033)},
-    (180.0, 1.04): {"heave": (0.1565, 0.1555), "pitch": (0.4158, 0.427)},
-    (180.0, 1.40): {"heave": (0.02635, 0.02634), "pitch": (0.05925, 0.05933)},
+    (180.0, 0.44): {"heave": (0.9163, 0.9182), "pitch": (1.075, 1.075)},
+    (180.0, 0.56): {"heave": (0.7827, 0.7801), "pitch": (1.609, 1.614)},
+    (180.0, 0.68): {"heave": (0.5504, 0.5471), "pitch": (2.046, 2.035)},
+    (180.0, 1.04): {"heave": (0.1565, 0.1555), "pitch": (0.4158, 0.4074)},
+    (180.0, 1.40): {"heave": (0.02635, 0.02634), "pitch": (0.05925, 0.05872)},
 }
 OMEGAS = (0.44, 0.56, 0.68, 1.04, 1.40)
 
@@ -248,8 +248,10 @@ def test_the_box_over_every_dataset_frequency_in_head_and_beam_seas(memory):
     """The paper's vessel with the box's memory at each of the dataset's 14 frequencies within
     0.3-1.9 rad/s, head and beam seas of 0.1 m: heave, roll and pitch within 5 % of the frequency
     domain wherever the RAO is at least 5 % of its peak (the frequency domain is exact at the
-    dataset's frequencies). One point misses and is reported as an expected failure: pitch in
-    head seas at 0.8 rad/s, 5.4 % low."""
+    dataset's frequencies). Measured: heave 0.7 %, roll 2.9 % (beam); heave 0.7 %, pitch 2.0 %
+    (head). The surge-pitch group's two oscillators beside its two ladders matter here: with two
+    ladders alone pitch was 5.4 % low at 0.8 rad/s, near its peak (docs: fluid-memory, "The
+    fit")."""
     from concurrent import futures
 
     w = radiation.retardation_data(seakeeping.DEFAULT_DATASET, vessel=phsplit.Vessel.paper())[0]
@@ -266,10 +268,4 @@ def test_the_box_over_every_dataset_frequency_in_head_and_beam_seas(memory):
             big = fd >= 0.05 * fd.max()
             worst[(beta, k)] = float(np.abs(got[beta][f"{k}_deviation"].values[big]).max())
     print(worst)
-    # measured: heave 0.7 %, roll 2.9 % (beam), heave 0.7 % (head); pitch in head seas is 5.4 %
-    # low at 0.8 rad/s, near its peak (the memory's surge-pitch fit, 11 % at worst per coupling)
-    assert max(v for k, v in worst.items() if k != (180.0, "pitch")) < 0.05, worst
-    assert worst[(180.0, "pitch")] < 0.06, worst
-    if worst[(180.0, "pitch")] >= 0.05:
-        pytest.xfail(f"head-sea pitch {100 * worst[(180.0, 'pitch')]:.1f} % off at 0.8 rad/s: the memory's "
-                     f"surge-pitch fit (docs/explanation/components/fluid-memory.md)")
+    assert max(worst.values()) < 0.05, worst

@@ -63,7 +63,7 @@ DOFS = ("surge", "sway", "heave", "roll", "pitch", "yaw")
 #: to 10-30 %, three to 3-19 % (the largest, surge-heave, a coupling 2.6 % of surge's own size),
 #: four to 3-18 % at 3.6 times the cost (measured on osv_capytaine.nc).
 DEFAULT_BLOCKS = {"heave": ["ladder"], "yaw": ["oscillator", "oscillator"],
-                  "sway_roll": ["ladder", "ladder", "ladder"], "surge_pitch": ["ladder", "ladder"]}
+                  "sway_roll": ["ladder", "ladder", "ladder"], "surge_pitch": ["ladder", "ladder", "oscillator", "oscillator"]}
 
 MAIN_COUPLINGS = ((2, 2), (3, 3), (4, 4), (1, 1), (2, 4), (1, 3))
 

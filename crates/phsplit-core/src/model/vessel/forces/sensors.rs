@@ -180,6 +180,24 @@ fn dropout(p: &mut Params, key: &str) -> crate::Result<Vec<(f64, f64)>> {
     Ok(out)
 }
 
+/// Two numbers of `[sensors]` (`what`: their unit and meaning), each in `range`; zero if absent.
+fn pair(
+    p: &mut Params,
+    key: &str,
+    what: &str,
+    range: &'static Physical,
+) -> crate::Result<[f64; 2]> {
+    let unit = what.split(',').next().unwrap_or(what);
+    match p.rows(T, key, 1, unit, Range::Physical(range))? {
+        None => Ok([0.0; 2]),
+        Some(r) if r.len() == 2 => Ok([r[0][0], r[1][0]]),
+        Some(r) => Err(Error::InvalidInput(format!(
+            "sensors.{key} must be 2 numbers ({what}), got {} entries",
+            r.len()
+        ))),
+    }
+}
+
 /// Table `[sensors]` (module documentation), or `None` without it.
 pub fn read(p: &mut Params) -> crate::Result<Option<Sensors>> {
     p.declare(T);
@@ -207,16 +225,7 @@ pub fn read(p: &mut Params) -> crate::Result<Option<Sensors>> {
     let gyro_bias = p
         .opt_f64(T, "gyro_bias", "rad", Range::Physical(&HEADING_ERROR))?
         .unwrap_or(0.0);
-    let gnss_bias = match p.rows(T, "gnss_bias", 1, "m", Range::Physical(&POSITION_BIAS))? {
-        None => [0.0; 2],
-        Some(r) if r.len() == 2 => [r[0][0], r[1][0]],
-        Some(r) => {
-            return Err(Error::InvalidInput(format!(
-                "sensors.gnss_bias must be 2 numbers (m, spatial x and y), got {} entries",
-                r.len()
-            )))
-        }
-    };
+    let gnss_bias = pair(p, "gnss_bias", "m, spatial x and y", &POSITION_BIAS)?;
     let antenna: Vector3<f64> = p
         .vec3(
             T,
@@ -229,16 +238,7 @@ pub fn read(p: &mut Params) -> crate::Result<Option<Sensors>> {
     let mru_noise = p
         .opt_f64(T, "mru_noise", "rad", Range::Physical(&ATTITUDE_NOISE))?
         .unwrap_or(0.0);
-    let mru_bias = match p.rows(T, "mru_bias", 1, "rad", Range::Physical(&ATTITUDE_ERROR))? {
-        None => [0.0; 2],
-        Some(r) if r.len() == 2 => [r[0][0], r[1][0]],
-        Some(r) => {
-            return Err(Error::InvalidInput(format!(
-                "sensors.mru_bias must be 2 numbers (rad, roll and pitch), got {} entries",
-                r.len()
-            )))
-        }
-    };
+    let mru_bias = pair(p, "mru_bias", "rad, roll and pitch", &ATTITUDE_ERROR)?;
     if antenna == Vector3::zeros() && (mru_noise != 0.0 || mru_bias != [0.0; 2]) {
         return Err(Error::InvalidInput(
             "sensors.mru_noise and mru_bias describe the MRU that refers the GNSS fix to the body origin; with the antenna at the origin nothing reads it: give sensors.gnss_antenna (m, body frame), or remove them".into(),
