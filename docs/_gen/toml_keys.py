@@ -23,24 +23,24 @@ OPT = "optional"
 # (unit, default, meaning). Units are SI; "-" means dimensionless or not a number.
 KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
     "vessel": {
-        "mass": ("kg", REQ, "rigid-body mass `mv` (paper App. D)"),
-        "inertia": ("kg m²", REQ, "principal moments of inertia `T1, T2, T3` about the centre of gravity"),
+        "mass": ("kg", REQ, "rigid-body mass `mv` (paper App. D), in (0, 1e9]"),
+        "inertia": ("kg m²", REQ, "principal moments of inertia `T1, T2, T3` about the centre of gravity, each in (0, 1e14]"),
         "center_of_gravity": ("m", "[0, 0, 0]", "centre of gravity from the body origin, body frame, z up (§5.14)"),
         "added_mass": ("kg, kg m, kg m²", "none", "6×6 symmetric added mass `M_A`; `M = M_RB + M_A` must be positive definite (§5.14)"),
         "damping_translational": ("kg/s", REQ + " (or `damping_matrix`)", "diagonal linear damping `Dt`, ≥ 0 (§2.4)"),
         "damping_rotational": ("kg m²/s", REQ + " (or `damping_matrix`)", "diagonal linear damping `Dr`, ≥ 0 (§2.4)"),
         "damping_matrix": ("SI per entry", "none", "full 6×6 linear damping, symmetric positive semidefinite, instead of the diagonals (§5.13)"),
-        "gm_transverse": ("m", REQ, "transverse metacentric height, > 0 (§2.3)"),
-        "gm_longitudinal": ("m", REQ, "longitudinal metacentric height, > 0 (§2.3)"),
-        "gravity": ("m/s²", REQ, "acceleration of gravity, > 0"),
-        "water_density": ("kg/m³", REQ, "water density, > 0"),
+        "gm_transverse": ("m", REQ, "transverse metacentric height, in (0, 2000] (§2.3)"),
+        "gm_longitudinal": ("m", REQ, "longitudinal metacentric height, in (0, 2000] (§2.3)"),
+        "gravity": ("m/s²", REQ, "acceleration of gravity, in [9.7, 9.9]"),
+        "water_density": ("kg/m³", REQ, "water density, in [950, 1250]"),
         "waterplane_area": ("m²", REQ, "waterplane area `A_wp`, > 0 (heave stiffness `ρ g A_wp`)"),
         "flotation_center_x": ("m", "0", "centre of flotation, body x; couples heave and pitch (§5.15)"),
         "flotation_center_y": ("m", "0", "centre of flotation, body y; couples heave and roll (§5.15)"),
     },
     "initial": {
         "euler": ("rad", REQ, "ZYX Euler angles (roll, pitch, yaw), eq. (21)"),
-        "position": ("m", REQ, "position of the body origin, spatial frame, z up"),
+        "position": ("m", REQ, "position of the body origin, spatial frame, z up, each within ±1e7"),
         "velocity": ("m/s", "[0, 0, 0]", "linear velocity, body frame"),
         "angular_velocity": ("rad/s", "[0, 0, 0]", "angular velocity, body frame"),
     },
@@ -52,7 +52,7 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "kd_rotational": ("N m s/rad", REQ, "derivative gains"),
         "ki_rotational": ("N m/(rad s)", REQ, "integral gains"),
         "euler_reference": ("rad", REQ, "set attitude (roll, pitch, yaw), each within ±2π"),
-        "position_reference": ("m", REQ, "set position, spatial frame"),
+        "position_reference": ("m", REQ, "set position, spatial frame, each within ±1e7"),
         "feedback": ("-", '"true_state"', '`"true_state"` (the paper\'s) or `"observer"`: the controller acts on the estimates of `[observer]` (§5.20)'),
         "anti_windup": ("-", '"none"', '`"none"` or `"back_calculation"` (Åström–Hägglund): the integral states are pulled towards what `[thrusters]` deliver while they saturate; needs `[thrusters]` and an integral gain'),
         "tracking_time": ("s", "√(kd/ki) per axis", "back-calculation's tracking time `T_t` for every axis, in (0, 86400]; needs `anti_windup = \"back_calculation\"`"),
@@ -462,6 +462,12 @@ RANGE_KEYS = {
     "pipe departure angle": "`pipe.departure_angle`",
     "schedule time": "`setpoint.times`, `setpoint.start_time`, `current.times`",
     "controller time constant": "`control.tracking_time`",
+    "vessel mass": "`vessel.mass`",
+    "moment of inertia": "`vessel.inertia`",
+    "gravity": "`vessel.gravity`",
+    "water density": "`vessel.water_density`",
+    "metacentric height": "`vessel.gm_transverse`, `vessel.gm_longitudinal`",
+    "position": "`initial.position`, `control.position_reference`",
 }
 
 

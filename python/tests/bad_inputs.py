@@ -139,9 +139,9 @@ CATALOGUE: list[Bad] = [
         ("vessel.gm_transverse", "> 0", "m")),
     Bad("negative GM_L", vessel_with("gm_longitudinal = 103.628", "gm_longitudinal = -103.6"), E,
         ("vessel.gm_longitudinal", "> 0")),
-    Bad("zero gravity", vessel_with("gravity = 9.81", "gravity = 0.0"), E, ("vessel.gravity", "> 0")),
+    Bad("zero gravity", vessel_with("gravity = 9.81", "gravity = 0.0"), E, ("vessel.gravity", "[9.7, 9.9]")),
     Bad("negative water density", vessel_with("water_density = 1.025e3", "water_density = -1.025e3"), E,
-        ("vessel.water_density", "> 0")),
+        ("vessel.water_density", "[950, 1250]")),
     Bad("zero water-plane area", vessel_with("waterplane_area = 1.3834e3", "waterplane_area = 0.0"), E,
         ("vessel.waterplane_area", "> 0", "m^2")),
     Bad("negative proportional gain", vessel_with("kp_translational = [4e5", "kp_translational = [-4e5"), E,
@@ -688,8 +688,8 @@ CATALOGUE += [
         ("would overwrite", "r.nc")),
     Bad("CLI: plot of a result without energy", on_result("plot", "r.nc", drop=("energy",)), C,
         ("no 'energy' variable", "position, euler, energy")),
-    Bad("CLI: plot of a result without time", on_result("plot", "r.nc", drop=("position",)), C,
-        ("no trajectory",)),
+    Bad("CLI: plot of a result without its trajectory", on_result("plot", "r.nc", drop=("position",)), C,
+        ("no variable position", "trajectory")),
     Bad("CLI: plot into an existing folder", on_result("plot", "r.nc", "--out", "img.png", more={"img.png": None}), C,
         ("--out", "img.png", "is a folder")),
     Bad("CLI: plot over the result file", on_result("plot", "r.nc", "--out", "r.nc"), C,
@@ -1529,7 +1529,7 @@ CATALOGUE += [
     Bad("capability of a vessel that already loses a thruster",
         lambda: phsplit.capability(_capability_lost(), directions=[0.0]), E,
         ("capability: vessel", "lost_at", "failures")),
-    Bad("failure study on no workers", lambda: _failures(max_workers=-1)(), E, ("max_workers", "≥ 1")),
+    Bad("failure study on no workers", lambda: _failures(max_workers=-1)(), E, ("max_workers", "from 1 to 512")),
     Bad("footprint of a file name", _footprint_of("file.nc", reference=(0.0, 0.0, 0.0)), E,
         ("footprint", "phsplit.Solution", "str")),
     Bad("footprint about a heading in degrees", _footprint_of("run", reference=(780.0, 20.0, 31.0)), E,
@@ -1810,4 +1810,97 @@ CATALOGUE += [
         ("sensors.mru_noise",)),
     Bad("MRU errors without an antenna offset", _sensors(_RATES + "mru_noise = 0.001\n"), E,
         ("mru_noise", "with the antenna at the origin nothing reads it", "gnss_antenna")),
+]
+
+
+# magnitudes no vessel, sea or planet has (the physical ranges of the vessel's own keys)
+CATALOGUE += [
+    Bad("a mass of 1e20 kg", vessel_with("mass = ", "mass = 1e20 #"), E, ("vessel.mass", "1e9")),
+    Bad("an inertia of 1e20 kg m^2", vessel_with("inertia = [2.873071e8", "inertia = [1e20"), E, ("vessel.inertia[0]", "1e14")),
+    Bad("gravity of 1000 m/s^2", vessel_with("gravity = 9.81", "gravity = 1000.0"), E, ("vessel.gravity", "on Earth")),
+    Bad("water of 1e6 kg/m^3", vessel_with("water_density = 1.025e3", "water_density = 1e6"), E,
+        ("vessel.water_density", "[950, 1250]")),
+    Bad("a metacentric height of 100 km", vessel_with("gm_transverse = 2.1440", "gm_transverse = 1e5"), E,
+        ("vessel.gm_transverse", "2000")),
+    Bad("an initial position 1e12 m away", vessel_with("position = [723.0", "position = [1e12"), E,
+        ("initial.position[0]", "1e7")),
+]
+
+
+def _fmu_export(**kw):
+    def run():
+        import phsplit.fmu as fmu
+
+        with tempfile.TemporaryDirectory() as d:
+            return fmu.export(None, os.path.join(d, "v.fmu"), **kw)
+
+    return run
+
+
+def _fmu_load(**kw):
+    def run():
+        import phsplit.fmu as fmu
+
+        with tempfile.TemporaryDirectory() as d:
+            return fmu.export_load(os.path.join(d, "l.fmu"), **kw)
+
+    return run
+
+
+def _capability_plot(path):
+    def run():
+        from phsplit.capability import polar_plot
+
+        ds = phsplit.capability("dp-capability", directions=[0.0, 90.0], failures="none")
+        with tempfile.TemporaryDirectory() as d:
+            return polar_plot(ds, os.path.join(d, path))
+
+    return run
+
+
+def _windy(**wind):
+    body = "".join(f"{k} = {v}\n" for k, v in wind.items())
+    return scenario('vessel = "paper"\n[environment.wind]\nspeed = 10.0\nfrontal_area = 200.0\n' + body)
+
+
+def _hydro_cog():
+    from phsplit import hydro
+    from phsplit.seakeeping import DEFAULT_DATASET
+
+    return hydro.from_capytaine(DEFAULT_DATASET, center_of_gravity=[0.0, 0.0])
+
+
+CATALOGUE += [
+    Bad("single failures on a million threads", _failures(max_workers=10 ** 6), E,
+        ("single_failures", "max_workers", "from 1 to 512")),
+    Bad("RAO by Runge-Kutta with the fluid memory",
+        lambda: phsplit.rao(phsplit.Vessel.paper(), [0.56], 90.0, method="rk4", check_only=True), E,
+        ("method = 'rk4'", "fluid memory", "fluid_memory=False")),
+    Bad("regular wave of negative amplitude", lambda: phsplit.sea.regular(-1.0, 1.0), E, ("regular: amplitude",)),
+    Bad("regular wave of zero frequency", lambda: phsplit.sea.regular(1.0, 0.0), E, ("regular: omega", "(0, 10]")),
+    Bad("Blendermann's table of a negative frontal area",
+        lambda: phsplit.sea.blendermann("offshore supply vessel", -100.0, 300.0, 50.0), E,
+        ("blendermann: frontal_area", "> 0")),
+    Bad("Harris's drag with the NPD spectrum", _windy(drag=0.003), E,
+        ("environment.wind.drag", "'harris'", "'npd'")),
+    Bad("NPD's height with the Harris spectrum", _windy(height=20.0, spectrum='"harris"'), E,
+        ("environment.wind.height", "'npd'")),
+    Bad("FMU of an empty model name", _fmu_export(model_name=""), E, ("model_name", "non-empty string")),
+    Bad("load FMU of a period given as text", _fmu_load(period="60"), E, ("period", "number of seconds")),
+    Bad("load FMU of a mean given as text", _fmu_load(force_mean=["1", "0", "0"]), E, ("force_mean", "3 numbers")),
+    Bad("polar plot into a text file", _capability_plot("cap.txt"), E, ("polar_plot: path", "cap.txt", ".png")),
+    Bad("simulate_many on a vessel's name", lambda: phsplit.simulate_many(_ONE, base="osvv", t_span=(0.0, 1.0)), E,
+        ("base must be a phsplit.Vessel", "'osvv'")),
+    Bad("Settings with a misspelt field", lambda: phsplit.Settings(t_spn=(0.0, 5.0)), E,
+        ("Settings()", "'t_spn'", "did you mean t_span")),
+    Bad("rerun of a number", lambda: phsplit.rerun(42), E, ("rerun", "path", "int")),
+    Bad("the dynamic pipe with SP4", lambda: phsplit.simulate(
+        phsplit.load_scenario("pipelay-dynamic").vessel, (0.0, 1.0), 0.5, "sp4"), E,
+        ("simulation.method", "order 4", "lie or sp2")),
+    Bad("hydrodynamic data placed at a centre of gravity of two numbers", _hydro_cog, E,
+        ("center_of_gravity", "three finite numbers")),
+    Bad("a scenario key given twice", scenario('[simulation]\nh = 1.0\nh = 0.5\n'), P,
+        ("the key h of [simulation] is given twice", "line 3")),
+    Bad("a scenario table given twice", scenario('[simulation]\nh = 1.0\n[simulation]\nmethod = "sp2"\n'), P,
+        ("the table [simulation] is given twice", "line 3")),
 ]

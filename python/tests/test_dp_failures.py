@@ -122,6 +122,10 @@ def test_a_failure_after_the_run_or_a_dropout_outside_it_is_reported(pipelay):
     late = lose(sc, 1, at=50.0)
     with pytest.warns(phsplit.SettingWarning, match=r"unit\[1\]\.lost_at = 50 s is after the run's end \(2 s\)"):
         phsplit.simulate(late, (0.0, 2.0), 0.5)
+    d = sc.vessel.to_dict()
+    d["thrusters"]["unit"][2]["stuck_at"] = 50.0
+    with pytest.warns(phsplit.SettingWarning, match=r"unit\[2\]\.stuck_at = 50 s is after the run's end"):
+        phsplit.simulate(phsplit.Vessel.from_dict(d), (0.0, 2.0), 0.5)
     import warnings
 
     with warnings.catch_warnings():

@@ -192,7 +192,7 @@ def test_the_shipped_dp_observer_scenario_sits_off_by_the_gnss_bias():
     assert np.max(s.ledger.relative_residual()) < 1e-10
 
 
-ARM = [-10.0, 4.0, -25.0]   # m, body frame: the antenna 25 m up a mast aft of the origin (z down)
+ARM = [-10.0, 4.0, 25.0]    # m, body frame: the antenna 25 m up a mast aft of the origin (z up)
 
 
 def test_the_gnss_antenna_is_referred_to_the_origin_with_the_mru_and_the_gyro():

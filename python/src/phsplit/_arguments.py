@@ -15,7 +15,7 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 def _names(sig: inspect.Signature) -> list[str]:
     return [p.name for p in sig.parameters.values()
-            if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD) and not p.name.startswith("_")]
+            if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD) and not p.name.startswith("_") and p.name != "self"]
 
 
 def explain(name: str, sig: inspect.Signature, args: tuple, kw: dict, error: TypeError) -> str:
@@ -32,10 +32,11 @@ def explain(name: str, sig: inspect.Signature, args: tuple, kw: dict, error: Typ
     return f"{name}(): {error}; {takes}"
 
 
-def checked(f: F) -> F:
-    """``f`` with its call's arguments bound to its signature first (see the module's text)."""
+def checked(f: F, name: str | None = None) -> F:
+    """``f`` with its call's arguments bound to its signature first (see the module's text);
+    ``name``: how the messages call it (default its qualified name)."""
     sig = inspect.signature(f)
-    name = f.__qualname__
+    name = name or f.__qualname__
 
     @functools.wraps(f)
     def call(*args: Any, **kw: Any) -> Any:

@@ -201,6 +201,9 @@ def simulate_many(cases: Sequence[Mapping[str, float]], base: Vessel | None = No
     NaN series; it does not stop the others. Settings may be given as keyword arguments."""
     import xarray as xr
 
+    if base is not None and not isinstance(base, Vessel):
+        raise _core.InvalidInputError(f"base must be a phsplit.Vessel (e.g. phsplit.Vessel.preset('osv')) or None for "
+                                      f"the paper's vessel, got {type(base).__name__} {base!r}")
     base = base or Vessel.paper()
     per_run = [k for k in ("events", "save_at", "initial", "running_max", "progress") if k in kw]
     if per_run:

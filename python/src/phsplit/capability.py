@@ -602,6 +602,13 @@ def polar_plot(ds, path: str, title: str | None = None) -> None:
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder) or os.path.isdir(path):
         _bad("polar_plot: path", f"{str(path)!r} is not a file in an existing folder")
+    from matplotlib.figure import Figure
+
+    kinds = Figure().canvas.get_supported_filetypes()
+    ext = os.path.splitext(str(path))[1].lower().lstrip(".")
+    if ext not in kinds:
+        _bad("polar_plot: path", f"{str(path)!r} names no image format matplotlib writes: end it in "
+             f"{', '.join('.' + k for k in sorted(kinds))}")
     if title is not None and not isinstance(title, str):
         _bad("polar_plot: title", f"must be a string or None, got {type(title).__name__}")
     import matplotlib

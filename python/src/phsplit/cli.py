@@ -765,8 +765,10 @@ def _plot(args) -> int:
     if not _writable_ancestor(d)[1]:
         raise UsageError(f"the folder of --out is not writable: {d!r}")
     with open_dataset(args.file) as ds:
-        if "position" not in ds or "euler" not in ds:
-            raise UsageError(f"{args.file!r} holds no trajectory (it is not a run's file)")
+        lacking = [k for k in ("position", "euler") if k not in ds]
+        if lacking:
+            raise UsageError(f"{args.file!r} has no variable {lacking[0]} (a run's trajectory): it is not a run's "
+                             f"file, or a damaged one")
         if "case" in ds.dims:
             raise UsageError(f"{args.file!r} holds cases of a sweep (a batch file of a sweep store), not one run; "
                              "plot one case in Python: phsplit.plotting.plot_dp(phsplit.results.sweep_case("

@@ -166,6 +166,9 @@ def check_failure_study(vessel: Vessel, settings: Settings, at: float, at_name: 
     return units
 
 
+#: Most threads of a failure study (as of ``simulate_many``).
+MAX_THREADS = 512
+
 #: How :func:`single_failures` fails each thruster: the key it sets, and how a case is named.
 FAILURE_MODES = {"lost": "lost_at", "stuck": "stuck_at"}
 
@@ -185,9 +188,9 @@ def single_failures(vessel: Vessel, settings: Settings, at: float, max_workers: 
         raise _core.InvalidInputError(f"single_failures: mode must be one of lost, stuck, both, got {mode!r}")
     units = check_failure_study(vessel, settings, at)
     if max_workers is not None and (isinstance(max_workers, bool) or not isinstance(max_workers, (int, np.integer))
-                                    or max_workers < 1):
-        raise _core.InvalidInputError(f"single_failures: max_workers must be a whole number ≥ 1 (or None: one per "
-                                      f"core), got {max_workers!r}")
+                                    or not 1 <= max_workers <= MAX_THREADS):
+        raise _core.InvalidInputError(f"single_failures: max_workers must be a whole number from 1 to {MAX_THREADS} "
+                                      f"(or None: one per core), got {max_workers!r}")
 
     def one(failure):
         lost, how = failure

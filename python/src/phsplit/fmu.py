@@ -29,6 +29,8 @@ import zipfile
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
+import numpy as np
+
 from . import _core
 
 #: The model identifier: the binary's file name in ``binaries/<platform>/``.
@@ -289,6 +291,8 @@ def export(scenario: Any = None, out: str | os.PathLike[str] = "vessel.fmu", *,
     (position and heading) and the current; its outputs the position, Euler angles, quaternion,
     body velocities, the controller's force and moment, the stored energy and the ledger by port.
     ``binaries`` adds binaries built for other platforms (``{"win64": "phsplit_fmu.dll"}``).
+    ``out``: the ``.fmu`` file to write (its missing folders are made); ``model_name``: the FMU's
+    name (default ``phsplit vessel (<scenario>)``), a non-empty string.
 
     >>> import phsplit.fmu, tempfile, os
     >>> path = phsplit.fmu.export(None, os.path.join(tempfile.mkdtemp(), "fig2.fmu"))
@@ -297,6 +301,9 @@ def export(scenario: Any = None, out: str | os.PathLike[str] = "vessel.fmu", *,
     """
     from . import scenario as sc
 
+    if model_name is not None and (not isinstance(model_name, str) or not model_name.strip()):
+        raise _core.InvalidInputError(f"model_name must be a non-empty string (the FMU's name), or None for "
+                                      f"phsplit's, got {model_name!r}")
     if scenario is None:
         s = sc.Scenario.paper_fig2()
     elif isinstance(scenario, sc.Scenario):
@@ -328,8 +335,15 @@ def export(scenario: Any = None, out: str | os.PathLike[str] = "vessel.fmu", *,
                       _binaries(binaries))
 
 
+def _real(v: Any) -> bool:
+    """A real number given as one (not a string, not a boolean)."""
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+
+
 def _vec3(name: str, v: Sequence[float]) -> list[float]:
     try:
+        if isinstance(v, (str, bytes)) or not all(_real(x) for x in v):
+            raise TypeError
         out = [float(x) for x in v]
     except (TypeError, ValueError):
         raise _core.InvalidInputError(f"{name} must be 3 numbers, got {v!r}") from None
@@ -359,10 +373,9 @@ def export_load(out: str | os.PathLike[str] = "load.fmu", *, force_mean: Sequenc
             "force_amplitude": _vec3("force_amplitude", force_amplitude),
             "moment_mean": _vec3("moment_mean", moment_mean),
             "moment_amplitude": _vec3("moment_amplitude", moment_amplitude)}
-    try:
-        p = float(period)
-    except (TypeError, ValueError):
-        raise _core.InvalidInputError(f"period must be a number of seconds, got {period!r}") from None
+    if not _real(period):
+        raise _core.InvalidInputError(f"period must be a number of seconds, got {period!r}")
+    p = float(period)
     if not (1e-3 <= p <= 1e7):
         raise _core.InvalidInputError(f"period must be a time in [1e-3, 1e7] s (a load varying faster than a "
                                       f"millisecond is no vessel's), got {period!r}")

@@ -554,6 +554,14 @@ def from_capytaine(ds, omega: float | None = None, symmetric: bool = False, *, c
         raise _err(f"hydro_checks must be one of {', '.join(repr(c) for c in CHECK_MODES)}, got {checks!r}")
     if not isinstance(symmetric, bool):
         raise _err(f"symmetric must be true or false, got {symmetric!r}")
+    if center_of_gravity is not None:
+        try:
+            cg = np.asarray(center_of_gravity, dtype=float)
+        except (TypeError, ValueError):
+            cg = np.full(1, np.nan)
+        if cg.shape != (3,) or not np.all(np.isfinite(cg)):
+            raise _err(f"center_of_gravity must be three finite numbers (m, the dataset's frame), got "
+                       f"{center_of_gravity!r}")
     params, r_g = _vessel_params(vessel)
     raw = _open(ds)
     d = _read(raw)
@@ -572,10 +580,7 @@ def from_capytaine(ds, omega: float | None = None, symmetric: bool = False, *, c
     if center_of_gravity is None:
         origin = d.cm - r_g
     else:
-        origin = np.asarray(center_of_gravity, dtype=float)
-        if origin.shape != (3,) or not np.all(np.isfinite(origin)):
-            raise _err(f"center_of_gravity must be three finite numbers (m, the dataset's frame), got {center_of_gravity!r}")
-        origin = origin - r_g
+        origin = np.asarray(center_of_gravity, dtype=float) - r_g
     r = origin - d.rc
     T = shift_matrix(r)
     A = T.T @ d.A @ T

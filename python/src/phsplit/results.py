@@ -170,6 +170,11 @@ def rerun(source, progress: bool = False):
     calls, and return its result as a dataset laid out like the file. A run the file records as
     interrupted is rerun to the step it reached. A case of a sweep's batch file: take it with
     :func:`sweep_case` first."""
+    import xarray as xr
+
+    if not isinstance(source, (str, os.PathLike, xr.Dataset)):
+        raise _core.InvalidInputError(f"rerun takes a phsplit result file's path or its open xarray.Dataset, got "
+                                      f"{type(source).__name__}")
     ds = open_dataset(source) if isinstance(source, (str, os.PathLike)) else source
     vessel, settings, y0, chunks = check_record(ds)
     if ds.attrs.get("status") == "interrupted" and settings.adaptive:

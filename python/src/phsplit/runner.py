@@ -99,11 +99,12 @@ def warn_if_timed_settings_idle(vessel: Vessel, t_span: tuple[float, float], sta
     t0, t1 = float(t_span[0]), float(t_span[1])
     d = vessel.to_dict()
     for i, unit in enumerate((d.get("thrusters") or {}).get("unit") or []):
-        at = unit.get("lost_at") if isinstance(unit, dict) else None
-        if isinstance(at, (int, float)) and not isinstance(at, bool) and at > t1:
-            warnings.warn(SettingWarning(
-                f"thrusters.unit[{i}].lost_at = {at:g} s is after the run's end ({t1:g} s): the thruster is not lost "
-                f"in this run"), stacklevel=user_stacklevel())
+        for key, what in (("lost_at", "lost"), ("stuck_at", "stuck")):
+            at = unit.get(key) if isinstance(unit, dict) else None
+            if isinstance(at, (int, float)) and not isinstance(at, bool) and at > t1:
+                warnings.warn(SettingWarning(
+                    f"thrusters.unit[{i}].{key} = {at:g} s is after the run's end ({t1:g} s): the thruster is not "
+                    f"{what} in this run"), stacklevel=user_stacklevel())
     for key in ("gnss_dropout", "gyro_dropout"):
         rows = (d.get("sensors") or {}).get(key) or []
         for k, row in enumerate(rows):

@@ -127,7 +127,32 @@ def _read_toml(p: str, what: str) -> dict[str, Any]:
         if re.search(r"^\s*vessel\s*=", text, re.M) and re.search(r"^\s*\[vessel\]", text, re.M):
             hint = ("; to change keys of a shipped vessel or a vessel file, name it in the table instead: "
                     "[vessel] from = \"osv\", then the keys to change")
+        twice = _given_twice(str(e), text)
+        if twice:
+            raise _core.ScenarioParseError(f"{p}: {twice}{hint}") from None
         raise _core.ScenarioParseError(f"{p}: TOML syntax error: {e}{hint}") from None
+
+
+def _given_twice(error: str, text: str) -> str | None:
+    """What tomllib's "Cannot overwrite a value" or "Cannot declare" means, with the key and its
+    table named: a key (or a table) given twice."""
+    m = re.search(r"^Cannot (?:overwrite a value|declare .*?)\s*\(at line (\d+), column \d+\)", error)
+    if not m:
+        return None
+    lines = text.splitlines()
+    n = int(m.group(1))
+    if not 1 <= n <= len(lines):
+        return None
+    line = lines[n - 1].strip()
+    table = next((h.strip() for h in reversed(lines[:n - 1]) if re.match(r"^\s*\[", h)), None)
+    key = re.match(r"^([A-Za-z0-9_.\"'-]+)\s*=", line)
+    if key:
+        where = f" of {table}" if table else ""
+        return f"the key {key.group(1)}{where} is given twice (again at line {n}): give each key once"
+    head = re.match(r"^(\[\[?[^\]]+\]\]?)", line)
+    if head:
+        return f"the table {head.group(1)} is given twice (again at line {n}), or a key already set it: give it once"
+    return None
 
 
 def from_dict(data: Mapping[str, Any], path: str, allowed_extra: tuple[str, ...] = (),

@@ -197,6 +197,15 @@ def _cos2s_draw(rng, s: float, n: int) -> np.ndarray:
 @checked
 def regular(amplitude: float, omega: float, direction: float = 0.0, phase: float = 0.0) -> dict[str, list[float]]:
     """One regular wave: amplitude (m), frequency (rad/s), direction (degrees), phase (rad)."""
+    if not (_number(amplitude) and 0 < amplitude <= 50):
+        raise _core.InvalidInputError(f"regular: amplitude must be a number in (0, 50] (m; no wave is higher), "
+                                      f"got {amplitude!r}")
+    if not (_number(omega) and 0 < omega <= 10):
+        raise _core.InvalidInputError(f"regular: omega must be a number in (0, 10] (rad/s; a sea's waves are below "
+                                      f"10 rad/s), got {omega!r}")
+    in_range("regular", "direction", direction)
+    if not _number(phase):
+        raise _core.InvalidInputError(f"regular: phase must be a finite number (rad), got {phase!r}")
     return {"frequencies": [float(omega)], "amplitudes": [float(amplitude)], "phases": [float(phase)],
             "directions": [float(direction)]}
 
@@ -348,6 +357,12 @@ def wind(table: dict) -> tuple[dict, dict]:
     if "speed" not in table:
         raise _core.ScenarioParseError("missing field 'speed' in [environment.wind] (mean wind speed at 10 m, m/s)")
     kw = {k: table[k] for k in own if k in table}
+    spectrum = kw.get("spectrum", "npd")
+    for key, used_by in (("drag", "harris"), ("height", "npd")):
+        if key in kw and spectrum != used_by:
+            raise _core.InvalidInputError(
+                f"environment.wind.{key} is a parameter of the {used_by!r} gust spectrum, and this wind's spectrum is "
+                f"{spectrum!r}: remove {key}, or set spectrum = {used_by!r}")
     if "omega_range" in kw:
         _check_range("wind", kw["omega_range"])
         kw["omega_range"] = tuple(kw["omega_range"])
@@ -413,7 +428,17 @@ def blendermann(ship_type: str, frontal_area: float, lateral_area: float, length
     its angle is that of the air's flow (0: from the stern): ``γ_r = π + γ``, and the sway force
     and yaw moment change sign. The yaw formula holds for ``γ_r`` in [0, π]; the other half is
     its mirror image (``C_N(−γ_r) = −C_N(γ_r)``)."""
-    if ship_type not in BLENDERMANN:
+    for name, v in (("frontal_area", frontal_area), ("lateral_area", lateral_area), ("length", length)):
+        if not (_number(v) and v > 0):
+            raise _core.InvalidInputError(f"blendermann: {name} must be a number > 0 (m^2, m^2, m), got {v!r}")
+    in_range("blendermann", "length", length)
+    if not _number(centroid_x) or abs(centroid_x) > length:
+        raise _core.InvalidInputError(f"blendermann: centroid_x must be a number within ±length ({length:g} m) of "
+                                      f"midships, got {centroid_x!r}")
+    if not (_number(step) and 0 < step <= 90 and abs(360.0 / step - round(360.0 / step)) < 1e-9):
+        raise _core.InvalidInputError(f"blendermann: step must be a number of degrees in (0, 90] that divides 360, "
+                                      f"got {step!r}")
+    if not isinstance(ship_type, str) or ship_type not in BLENDERMANN:
         raise _core.InvalidInputError(f"unknown ship type {ship_type!r} for Blendermann's wind loads; known: "
                                       f"{', '.join(sorted(BLENDERMANN))}")
     cdt, bow, stern, delta, _kappa = BLENDERMANN[ship_type]

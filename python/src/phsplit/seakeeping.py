@@ -348,6 +348,9 @@ def rao(vessel, frequencies, heading: float, dofs=("heave", "roll", "pitch"), *,
     if "pipe" in tables:
         raise _err("the RAO is the free vessel's in regular waves: the vessel has a [pipe], which holds it; "
                    "give the vessel without it")
+    if fluid_memory is not False and _core.method_info(method)["kind"] != "splitting":
+        raise _err(f"method = {method!r} is explicit Runge-Kutta, which takes no subsystem with states of its own, "
+                   f"and the fluid memory is one: use a splitting method (sp2, sp4, ...), or fluid_memory=False")
     if fluid_memory is not False and "port_hamiltonian" in tables:
         name = tables["port_hamiltonian"].get("name")
         raise _err(f"the vessel already has a port-Hamiltonian subsystem ({name!r}"

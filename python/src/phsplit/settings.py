@@ -9,6 +9,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from . import _core, _provided
+from ._arguments import checked
 
 _DEFAULTS = _core.default_settings()
 
@@ -74,6 +75,10 @@ class Settings:
     def run(self, vessel, **kw):
         """``phsplit.simulate(vessel, settings=self, **kw)``."""
         return _provided.get("simulate")(vessel, settings=self, **kw)
+
+
+# An unknown or misspelt field is an InvalidInputError naming it, as for the functions.
+Settings.__init__ = checked(Settings.__init__, "Settings")  # type: ignore[method-assign]
 
 
 def settings_to_toml(settings: Mapping[str, Any]) -> str:

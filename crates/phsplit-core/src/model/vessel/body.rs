@@ -18,7 +18,7 @@
 //! (`flows/rigid_body.rs`); any other `M` has flow S1 by Kirchhoff's equations
 //! (`flows/kirchhoff.rs`, docs/model.md §3.8).
 
-use super::params::{Params, Range};
+use super::params::{physical, Params, Range};
 use super::state::VesselState;
 use crate::error::{Error, Result};
 use crate::flows::kirchhoff::Kirchhoff;
@@ -65,9 +65,15 @@ pub fn block(m: &M6, i: usize, j: usize) -> Matrix3<f64> {
 impl Body {
     pub(crate) fn read(p: &mut Params) -> Result<Self> {
         const T: &str = "vessel";
-        let mass = p.f64(T, "mass", "kg", Range::Positive)?;
+        let mass = p.f64(T, "mass", "kg", Range::Physical(&physical::MASS))?;
         let inertia: Vector3<f64> = p
-            .vec3(T, "inertia", None, "kg m^2", Range::Positive)?
+            .vec3(
+                T,
+                "inertia",
+                None,
+                "kg m^2",
+                Range::Physical(&physical::INERTIA),
+            )?
             .into();
         let rg: Vector3<f64> = p
             .vec3(T, "center_of_gravity", Some([0.0; 3]), "m", Range::Finite)?

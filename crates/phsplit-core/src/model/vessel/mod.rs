@@ -72,7 +72,13 @@ impl Initial {
         const T: &str = "initial";
         Ok(Self {
             euler: p.vec3(T, "euler", None, "rad", Range::Finite)?,
-            position: p.vec3(T, "position", None, "m", Range::Finite)?,
+            position: p.vec3(
+                T,
+                "position",
+                None,
+                "m",
+                Range::Physical(&params::physical::POSITION),
+            )?,
             velocity: p.vec3(T, "velocity", Some([0.0; 3]), "m/s", Range::Finite)?,
             angular_velocity: p.vec3(
                 T,

@@ -154,9 +154,58 @@ pub mod physical {
         hi_closed: true,
         why: "a controller's time constant is positive and at most a day",
     };
+    /// A vessel's mass (kg): the largest ships ever built displaced under 7e8 kg.
+    pub const MASS: Physical = Physical {
+        lo: 0.0,
+        hi: 1e9,
+        lo_closed: false,
+        hi_closed: true,
+        why: "no vessel displaces more than 1e9 kg",
+    };
+    /// A vessel's moment of inertia (kg m²): the largest ship's yaw inertia is about 1e13.
+    pub const INERTIA: Physical = Physical {
+        lo: 0.0,
+        hi: 1e14,
+        lo_closed: false,
+        hi_closed: true,
+        why: "ten times the largest ship's yaw inertia",
+    };
+    /// The acceleration of gravity (m/s²): 9.78 at the equator to 9.83 at the poles.
+    pub const GRAVITY: Physical = Physical {
+        lo: 9.7,
+        hi: 9.9,
+        lo_closed: true,
+        hi_closed: true,
+        why: "the sea is on Earth, where gravity is 9.78 to 9.83 m/s^2",
+    };
+    /// The water's density (kg/m³): fresh water 1000, sea water about 1025, the Dead Sea 1240.
+    pub const WATER_DENSITY: Physical = Physical {
+        lo: 950.0,
+        hi: 1250.0,
+        lo_closed: true,
+        hi_closed: true,
+        why: "fresh water is 1000 kg/m^3, sea water about 1025, the saltiest lake 1240",
+    };
+    /// A metacentric height (m): longitudinal ones are of the order of the hull's length.
+    pub const METACENTRIC_HEIGHT: Physical = Physical {
+        lo: 0.0,
+        hi: 2000.0,
+        lo_closed: false,
+        hi_closed: true,
+        why: "a metacentric height is of the order of the hull's beam or length, under 2 km",
+    };
+    /// A position in the spatial frame (m): within 10,000 km of its origin.
+    pub const POSITION: Physical = Physical {
+        lo: -1e7,
+        hi: 1e7,
+        lo_closed: true,
+        hi_closed: true,
+        why:
+            "within 10000 km of the spatial frame's origin (a quarter of the Earth's circumference)",
+    };
 
     /// Every named range, for the documentation.
-    pub const ALL: [(&str, &str, Physical); 9] = [
+    pub const ALL: [(&str, &str, Physical); 15] = [
         ("hull length", "m", HULL_LENGTH),
         ("hull beam", "m", HULL_BEAM),
         ("draught", "m", DRAFT),
@@ -166,6 +215,12 @@ pub mod physical {
         ("pipe departure angle", "degrees", DEPARTURE_ANGLE),
         ("schedule time", "s", TIME),
         ("controller time constant", "s", TRACKING_TIME),
+        ("vessel mass", "kg", MASS),
+        ("moment of inertia", "kg m^2", INERTIA),
+        ("gravity", "m/s^2", GRAVITY),
+        ("water density", "kg/m^3", WATER_DENSITY),
+        ("metacentric height", "m", METACENTRIC_HEIGHT),
+        ("position", "m", POSITION),
     ];
 }
 

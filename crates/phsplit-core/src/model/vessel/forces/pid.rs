@@ -86,7 +86,13 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
         "rad",
         Range::Physical(&physical::ANGLE_RAD),
     )?;
-    let position_reference = p.vec3("control", "position_reference", None, "m", Range::Finite)?;
+    let position_reference = p.vec3(
+        "control",
+        "position_reference",
+        None,
+        "m",
+        Range::Physical(&physical::POSITION),
+    )?;
     let setpoint = super::setpoint::read(p, &euler_reference)?;
     let thrusters = thrusters::read(p)?;
     let anti_windup = anti_windup::read(

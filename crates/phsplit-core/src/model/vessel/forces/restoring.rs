@@ -21,7 +21,7 @@
 
 use super::{Force, Frozen, Rows, S2Builder, Sys};
 use crate::lie::so3;
-use crate::model::vessel::params::{Params, Range};
+use crate::model::vessel::params::{physical, Params, Range};
 use crate::model::vessel::state::VesselState;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
@@ -52,10 +52,21 @@ pub struct Restoring {
 /// (kg/m³), `waterplane_area` (m²): all required, > 0; `flotation_center_x`,
 /// `flotation_center_y` (m, body frame, default 0, within ±1000 m).
 pub fn build(p: &mut Params, body: &super::Body) -> crate::Result<Option<Arc<dyn Force>>> {
-    let gm_t = p.f64("vessel", "gm_transverse", "m", Range::Positive)?;
-    let gm_l = p.f64("vessel", "gm_longitudinal", "m", Range::Positive)?;
-    let gravity = p.f64("vessel", "gravity", "m/s^2", Range::Positive)?;
-    let rho = p.f64("vessel", "water_density", "kg/m^3", Range::Positive)?;
+    let gm = Range::Physical(&physical::METACENTRIC_HEIGHT);
+    let gm_t = p.f64("vessel", "gm_transverse", "m", gm)?;
+    let gm_l = p.f64("vessel", "gm_longitudinal", "m", gm)?;
+    let gravity = p.f64(
+        "vessel",
+        "gravity",
+        "m/s^2",
+        Range::Physical(&physical::GRAVITY),
+    )?;
+    let rho = p.f64(
+        "vessel",
+        "water_density",
+        "kg/m^3",
+        Range::Physical(&physical::WATER_DENSITY),
+    )?;
     let awp = p.f64("vessel", "waterplane_area", "m^2", Range::Positive)?;
     let mut rf = Vector3::zeros();
     for (i, key) in ["flotation_center_x", "flotation_center_y"]

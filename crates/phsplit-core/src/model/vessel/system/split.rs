@@ -28,12 +28,12 @@ impl SplitModel for VesselSystem<'_> {
     fn supports_order(&self, order: usize) -> Result<()> {
         if order > 2 && !self.own_flowing.is_empty() {
             return Err(Error::InvalidInput(format!(
-                "a composition of order {order} needs sub-flows of order {order}; the lumped-mass pipe's flow is nested in flow S2 by Strang's rule, of order 2: use lie or sp2 (or pipe.model = \"catenary\")"
+                "the method (simulation.method, method=) is a composition of order {order}, which needs sub-flows of order {order}; the lumped-mass pipe's flow is nested in flow S2 by Strang's rule, of order 2: use lie or sp2 (or pipe.model = \"catenary\")"
             )));
         }
         if order > MAX_SUBFLOW_ORDER {
             return Err(Error::InvalidInput(format!(
-                "a composition of order {order} needs sub-flows of order {order}; the vessel's flows provide order {MAX_SUBFLOW_ORDER} at most (Magnus 6, Gauss collocation with 3 stages)"
+                "the method (simulation.method, method=) is a composition of order {order}, which needs sub-flows of order {order}; the vessel's flows provide order {MAX_SUBFLOW_ORDER} at most (Magnus 6, Gauss collocation with 3 stages)"
             )));
         }
         Ok(())
