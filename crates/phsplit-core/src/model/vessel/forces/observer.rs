@@ -44,6 +44,7 @@ use super::sensors::{self, Sensors};
 use parts::{gains, states};
 
 mod parts;
+mod thrust;
 use super::{Frozen, Output, OwnLinear, OwnState, HELD};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
