@@ -108,7 +108,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
             }
             if thrusters.as_ref().is_some_and(|th| th.rate_limited()) {
                 return Err(Error::InvalidInput(
-                    "control.feedback = \"observer\" does not take rate-limited thrusters (thrusters.unit[*].thrust_rate, turn_rate): their memory follows the demand on the vessel's state; remove the rate limits or use feedback = \"true_state\"".into(),
+                    "control.feedback = \"observer\" does not take rate-limited thrusters (thrusters.unit[*].thrust_rate, turn_rate): their memory is kept from the demand on the vessel's state, not the observer's; remove the rate limits or use feedback = \"true_state\"".into(),
                 ));
             }
             let gains = observer::Gains {

@@ -2,6 +2,9 @@
 //! stage system solved once per sub-step, the forcing (on the block states and on the own
 //! states) iterated to a fixed point, and the ledger by Gauss quadrature.
 
+// Stage loops index the Butcher tableau `a_ij`, `b_i` and the stages as the formulas write them.
+#![allow(clippy::needless_range_loop)]
+
 use super::super::super::forces::{Forcing, Frozen, S2Builder};
 use super::super::{GaveUp, VesselSystem};
 use super::MAX_PASSES;
