@@ -189,6 +189,26 @@ def test_the_ledger_books_what_the_thrusters_deliver():
     assert abs(s.outputs["commanded_surge"][2][1]) > abs(s.outputs["delivered_surge"][2][1])
 
 
+def test_with_sensors_and_adaptive_steps():
+    """Sampled, noisy sensors with a GNSS dropout, and a thruster lost between the steps of a
+    fixed grid: the ledger closes with fixed and adaptive steps, and adaptive steps land on the
+    loss."""
+    units = [dict(u) for u in OSV_THRUSTERS["unit"]]
+    units[0]["lost_at"] = 15.3
+    _, d = with_thrusters(units, anti_windup="back_calculation")
+    d["sensors"] = {"gnss_rate": 1.0, "gyro_rate": 2.0, "gnss_noise": 0.5, "gyro_noise": 0.002,
+                    "gnss_bias": [0.3, -0.2], "gyro_bias": 0.001, "gnss_dropout": [[10.0, 20.0]], "seed": 3}
+    v = phsplit.Vessel.from_dict(d)
+    s = phsplit.simulate(v, (0.0, 40.0), 0.25, "sp4", control_start=0.0, save_every=4)
+    assert np.max(s.ledger.relative_residual()) < 1e-10
+    a = phsplit.simulate(v, (0.0, 40.0), 0.25, "sp4", control_start=0.0, rtol=1e-6)
+    assert np.max(a.ledger.relative_residual()) < 1e-10
+    k = int(np.argmin(np.abs(a.t - 15.3)))
+    assert a.t[k] == pytest.approx(15.3, abs=1e-12)
+    avail = a.outputs["thruster0_available"][2]
+    assert avail[k - 1] == 1.0 and np.all(avail[k:] == 0.0)
+
+
 def test_limits_that_never_bind_are_the_plain_observer_run():
     """Thrusters in the plane of the origin (no heel or trim from their arms) and far beyond any
     demand deliver the demand exactly: the run is the observer's without thrusters (the same

@@ -77,3 +77,83 @@ impl Observer {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::{Forcing, Frozen};
+    use crate::lie::so3;
+    use crate::model::vessel::{Vessel, PAPER_VESSEL_TOML};
+    use nalgebra::{DVector, Rotation3, Vector3};
+
+    /// The demand the forcing allocates (reported as `commanded_*`) is the one the observer's
+    /// rows put on the hull, at headings all round and arbitrary estimates; thrusters in the
+    /// plane of the origin that never bind deliver it, so the forcing adds only round-off to the
+    /// hull, the velocity estimate and the integral states.
+    #[test]
+    fn the_allocated_demand_is_the_rows_and_never_binding_thrusters_add_nothing() {
+        let unit = |kind: &str, x: f64, y: f64| {
+            format!("[[thrusters.unit]]\nkind = \"{kind}\"\nposition = [{x}, {y}, 0.0]\nmax_thrust = 1e12\n")
+        };
+        let thrusters = format!(
+            "[thrusters]\nhull_length = 83.0\nhull_beam = 18.0\n{}{}{}",
+            unit("tunnel", 37.0, 0.0),
+            unit("azimuth", -41.5, 7.0),
+            unit("azimuth", -41.5, -7.0)
+        );
+        let text = PAPER_VESSEL_TOML.replacen(
+            "[control]\n",
+            &format!("[observer]\nwave_frequency = 0.7\ndamping = [3.5e4, 1.2e5, 3.2e8]\n\n{thrusters}\n[control]\nfeedback = \"observer\"\nanti_windup = \"back_calculation\"\n"),
+            1,
+        );
+        let v = Vessel::from_toml_str(&text).unwrap();
+        let pid = v.forces.iter().find(|f| f.name() == "pid").unwrap();
+        assert!(pid.forced() && pid.forcing_uses_state());
+        assert_eq!(pid.accounts()[0].name, "thrusters");
+        let z = [[Vector3::zeros(); 3]; 2];
+        for (k, psi) in [-3.1, -0.4, 0.54, 1.7, 3.1].into_iter().enumerate() {
+            let q = Rotation3::from_euler_angles(0.03, -0.02, psi).into_inner();
+            let (euler, w) = so3::euler_and_w(&q);
+            let fr = Frozen {
+                q,
+                qt: q.transpose(),
+                q3: q.transpose().column(2).into_owned(),
+                euler,
+                w,
+                origin: Vector3::new(780.0, 20.0, 0.0),
+                control_on: true,
+                body: &v.body,
+                velocity: [Vector3::zeros(); 2],
+                actuators: Default::default(),
+                held: None,
+            };
+            let x: Vec<f64> = (0..super::N)
+                .map(|i| 10.0 * (0.37 * i as f64 + k as f64).sin())
+                .collect();
+            let rows = pid.own_linear_at(&fr).unwrap();
+            let tau = &rows.fx * DVector::from_column_slice(&x) + &rows.fc;
+            let size = tau.amax();
+            let mut out = Vec::new();
+            pid.own_outputs(&fr, &z, &x, 0.0, &mut out);
+            let get = |n: &str| out.iter().find(|o| o.name == n).unwrap().value;
+            for (name, i) in [
+                ("commanded_surge", 0),
+                ("commanded_sway", 1),
+                ("commanded_yaw", 5),
+            ] {
+                assert!(
+                    (get(name) - tau[i]).abs() <= 1e-13 * size,
+                    "{psi}: {name} {} against the rows' {}",
+                    get(name),
+                    tau[i]
+                );
+            }
+            let mut g = Forcing::new();
+            pid.add_forcing_own(&fr, 0.0, &z, &x, &mut g);
+            let hull = g.g[0][0].amax().max(g.g[1][0].amax());
+            assert!(hull <= 1e-12 * size, "{psi}: hull {hull} of {size}");
+            let own = g.own.iter().fold(0.0f64, |m, r| m.max(r.abs()));
+            assert!(own <= 1e-12 * size / 6e6, "{psi}: own states {own}");
+            assert!(g.own.len() == super::INT + 3, "{}", g.own.len());
+        }
+    }
+}
