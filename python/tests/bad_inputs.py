@@ -1327,6 +1327,21 @@ CATALOGUE += [
         ("observer.damping",)),
     Bad("observer with a key it does not take", _observer("wave_period = 9.0\n"), E,
         ("wave_period", "[observer]")),
+    Bad("controller on the observer with rate-limited thrusters",
+        lambda: phsplit.Vessel.from_toml_str(
+            PAPER.replace("[control]\n", _OBS + '\n[control]\nfeedback = "observer"\n', 1)
+            .replace("[initial]", _rated(), 1)), E,
+        ("control.feedback", "thrusters that keep a memory", "thrust_rate", "true_state")),
+    Bad("controller on the observer with a thruster that sticks",
+        lambda: phsplit.Vessel.from_toml_str(
+            PAPER.replace("[control]\n", _OBS + '\n[control]\nfeedback = "observer"\n', 1)
+            .replace("[initial]", _rated(azimuth="stuck_at = 5.0\n"), 1)), E,
+        ("control.feedback", "stuck_at", "lost_at")),
+    Bad("controller on the observer with a moving set point",
+        lambda: phsplit.Vessel.from_toml_str(
+            PAPER.replace("[control]\n", _OBS + '\n[control]\nfeedback = "observer"\n', 1)
+            .replace("[initial]", _SETPOINT.format(when="speed = 0.5", extra=""), 1)), E,
+        ("control.feedback", "[setpoint]", "true_state")),
 ]
 
 

@@ -179,7 +179,7 @@ def test_states_with_the_memory_go_where_states_go():
 
 def test_runge_kutta_and_bad_rates_are_refused_with_messages():
     v = vessel(thrusters=limited())
-    with pytest.raises(phsplit.InvalidInputError, match="rate-limited thrusters .* use a splitting method"):
+    with pytest.raises(phsplit.InvalidInputError, match="rate-limited thrusters .* stuck ones .* use a splitting method"):
         phsplit.simulate(v, (0.0, 5.0), 0.5, "rk4", control_start=0.0)
     bad = copy.deepcopy(OSV_THRUSTERS)
     bad["unit"][0]["thrust_rate"] = -1.0
@@ -194,7 +194,7 @@ def test_runge_kutta_and_bad_rates_are_refused_with_messages():
     with pytest.raises(phsplit.InvalidInputError, match="at most 8 are kept"):
         vessel(thrusters=many)
     state = v.initial_state()
-    with pytest.raises(phsplit.InvalidInputError, match="or 36 with the memory of the vessel's 4 rate-limited"):
+    with pytest.raises(phsplit.InvalidInputError, match="or 36 with the memory of the vessel's 4 thrusters that keep one"):
         phsplit.simulate(v, (0.0, 1.0), 0.5, "sp2", initial=np.concatenate([state, [0.0, 1.0]]))
     # a memory that is not one a run could have written
     s = phsplit.simulate(v, (0.0, 10.0), 0.5, "sp2", control_start=0.0)

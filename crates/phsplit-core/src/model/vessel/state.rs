@@ -74,7 +74,7 @@ impl Actuators {
     pub fn from_flat(v: &[f64], n: usize) -> Result<Self> {
         if n == 0 || n > MAX_ACTUATORS || v.len() != 1 + 2 * n {
             return Err(Error::InvalidInput(format!(
-                "the thrusters' memory of a state that continues a run has 1 + 2n numbers (time, each thruster's thrust, each thruster's angle) for n = {n} rate-limited thrusters, got {}",
+                "the thrusters' memory of a state that continues a run has 1 + 2n numbers (time, each thruster's thrust, each thruster's angle) for n = {n} thrusters that keep a memory (rate limits, stuck_at), got {}",
                 v.len()
             )));
         }
@@ -164,9 +164,9 @@ impl VesselState {
         if y.len() != base && (actuators == 0 || y.len() != with_memory) {
             let what = match (own, actuators) {
                 (0, 0) => format!("a state is a flat vector of {STATE_DIM} numbers"),
-                (0, a) => format!("a state to continue from is a flat vector of {STATE_DIM} numbers, or {with_memory} with the memory of the {a} rate-limited thrusters"),
+                (0, a) => format!("a state to continue from is a flat vector of {STATE_DIM} numbers, or {with_memory} with the memory of the {a} thrusters (rate limits, stuck_at)"),
                 (o, 0) => format!("a state to continue from is a flat vector of {base} numbers ({STATE_DIM}, then the components' {o} own states)"),
-                (o, a) => format!("a state to continue from is a flat vector of {base} numbers ({STATE_DIM}, then the components' {o} own states), or {with_memory} with the memory of the {a} rate-limited thrusters"),
+                (o, a) => format!("a state to continue from is a flat vector of {base} numbers ({STATE_DIM}, then the components' {o} own states), or {with_memory} with the memory of the {a} thrusters (rate limits, stuck_at)"),
             };
             return Err(Error::InvalidInput(format!("{what}, got {}", y.len())));
         }
@@ -214,7 +214,7 @@ impl VesselState {
             }
             if actuators > 0 {
                 what += &format!(
-                    ", or {with_memory} with the memory of the vessel's {actuators} rate-limited thrusters (time, thrusts, angles)"
+                    ", or {with_memory} with the memory of the vessel's {actuators} thrusters that keep one (rate limits, stuck_at: time, thrusts, angles)"
                 );
             }
             return Err(Error::InvalidInput(format!("{what}, got {}", y.len())));

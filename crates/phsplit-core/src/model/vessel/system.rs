@@ -211,35 +211,38 @@ impl<'a> VesselSystem<'a> {
         }
     }
 
-    /// The forcing of flow S2 at time `t` and block states `z` (zero without forced
+    /// The forcing of flow S2 at time `t`, block states `z` and own states `x`
+    /// ([`VesselState::own`]'s layout; empty where there are none) (zero without forced
     /// components).
-    fn forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2]) -> Forcing {
-        self.forcing_of(fr, t, z, None)
-    }
-
-    /// The forcing of the components whose forcing uses the state (`Some(true)`), does not
-    /// (`Some(false)`), or of all (`None`).
-    fn forcing_of(&self, fr: &Frozen, t: f64, z: &[Z3; 2], uses_state: Option<bool>) -> Forcing {
+    fn forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], x: &[f64]) -> Forcing {
         let mut g = Forcing::new();
-        self.add_forcing_of(fr, t, z, uses_state, &mut g);
+        self.add_forcing_of(fr, t, z, x, None, &mut g);
         g
     }
 
-    /// [`Self::forcing_of`], added to `g`.
+    /// The forcing of the components whose forcing uses the state (`Some(true)`), does not
+    /// (`Some(false)`), or of all (`None`), at the own states `x` (empty where there are none;
+    /// a component then gets an empty slice of its own), added to `g`.
     fn add_forcing_of(
         &self,
         fr: &Frozen,
         t: f64,
         z: &[Z3; 2],
+        x: &[f64],
         uses_state: Option<bool>,
         g: &mut Forcing,
     ) {
         if self.forced {
+            let mut off = 0;
             for (f, base) in self.vessel.forces.iter().zip(&self.bases) {
+                let n = f.own_states().len();
                 if f.forced() && uses_state.is_none_or(|u| u == f.forcing_uses_state()) {
                     g.base = *base;
-                    f.add_forcing(fr, t, z, g);
+                    g.own_base = off;
+                    let own = x.get(off..off + n).unwrap_or(&[]);
+                    f.add_forcing_own(fr, t, z, own, g);
                 }
+                off += n;
             }
         }
     }
@@ -393,8 +396,8 @@ impl<'a> VesselSystem<'a> {
                     fr[0] += c[1][0] * zs[0][0] + c[1][2] * zs[0][1];
                     fr[1] += c[1][1] * zs[0][0];
                 }
-                if self.forced {
-                    let g = self.forcing(&view, t, &zs);
+                let g = self.forced.then(|| self.forcing(&view, t, &zs, &s.own));
+                if let Some(g) = &g {
                     for i in 0..3 {
                         ft[i] += g.g[0][i];
                         fr[i] += g.g[1][i];
@@ -403,6 +406,11 @@ impl<'a> VesselSystem<'a> {
                 let mut own = Vec::new();
                 if self.own_dim > 0 {
                     let (mut rates, tau) = self.own_field(&view, &zs, &s.own);
+                    if let Some(g) = &g {
+                        for (k, r) in rates.iter_mut().enumerate() {
+                            *r += g.own_part(k);
+                        }
+                    }
                     ft[0] += tau[0];
                     fr[0] += tau[1];
                     for (_, tau) in self.own_flow_field(&view, s, &mut rates) {

@@ -40,11 +40,12 @@ use super::state::{Actuators, VesselState};
 use super::Body;
 use crate::error::Result;
 use crate::flows::collocation::{Blocks, Z3};
-use crate::solve::{Account, INLINE_ACCOUNTS};
+use crate::solve::Account;
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 use std::sync::Arc;
 
+pub use forcing::Forcing;
 pub use own::{Output, OwnLinear, OwnState};
 
 pub mod anti_windup;
@@ -53,6 +54,7 @@ pub mod current;
 pub mod damping;
 pub mod damping_quadratic;
 pub mod external;
+mod forcing;
 pub mod observer;
 mod own;
 pub mod pid;
@@ -370,78 +372,6 @@ impl S2Builder {
     }
 }
 
-/// The forcing of flow S2 at one time and block state: what the components' non-affine or
-/// time-dependent parts add to the fields of the two block systems, and, per account, the
-/// forces they book (the first [`INLINE_ACCOUNTS`] inline, any further on the heap, as in
-/// [`crate::solve::Work`]).
-#[derive(Debug, Clone)]
-pub struct Forcing {
-    /// Added to `(u', v', w')` of each block system.
-    pub g: [Z3; 2],
-    /// The booked force on the momentum of each system, per account.
-    booked: [[Vector3<f64>; 2]; INLINE_ACCOUNTS],
-    /// The same for accounts `INLINE_ACCOUNTS..`, as far as any was booked.
-    spill: Vec<[Vector3<f64>; 2]>,
-    /// First account of the component being evaluated.
-    pub(crate) base: usize,
-}
-
-impl Forcing {
-    pub(crate) fn new() -> Self {
-        Self {
-            g: [[Vector3::zeros(); 3]; 2],
-            booked: [[Vector3::zeros(); 2]; INLINE_ACCOUNTS],
-            spill: Vec::new(),
-            base: 0,
-        }
-    }
-    /// Add a force on the momentum of `sys`, booked to the component's account `account` (its
-    /// index in [`Force::accounts`]), or to none (a conservative exchange between stores of H).
-    #[inline]
-    pub fn force(&mut self, sys: Sys, account: Option<usize>, f: Vector3<f64>) {
-        self.g[sys as usize][0] += f;
-        if let Some(k) = account {
-            let k = self.base + k;
-            match self.booked.get_mut(k) {
-                Some(b) => b[sys as usize] += f,
-                None => self.spilled(k - INLINE_ACCOUNTS)[sys as usize] += f,
-            }
-        }
-    }
-    #[cold]
-    fn spilled(&mut self, j: usize) -> &mut [Vector3<f64>; 2] {
-        if j >= self.spill.len() {
-            self.spill.resize(j + 1, [Vector3::zeros(); 2]);
-        }
-        &mut self.spill[j]
-    }
-    /// No forcing again.
-    #[inline]
-    pub(crate) fn clear(&mut self) {
-        self.g = [[Vector3::zeros(); 3]; 2];
-        self.booked = [[Vector3::zeros(); 2]; INLINE_ACCOUNTS];
-        self.spill
-            .iter_mut()
-            .for_each(|b| *b = [Vector3::zeros(); 2]);
-    }
-    /// Add to the rate of the third state of `sys` (an integral state).
-    pub fn rate_w(&mut self, sys: Sys, r: Vector3<f64>) {
-        self.g[sys as usize][2] += r;
-    }
-    /// The force booked to account `k` on the momentum of each system.
-    #[inline]
-    pub fn booked(&self, k: usize) -> [Vector3<f64>; 2] {
-        match self.booked.get(k) {
-            Some(b) => *b,
-            None => self
-                .spill
-                .get(k - INLINE_ACCOUNTS)
-                .copied()
-                .unwrap_or([Vector3::zeros(); 2]),
-        }
-    }
-}
-
 /// A force or port of the vessel. See the module documentation for the contract.
 pub trait Force: Debug + Send + Sync {
     /// The component's name (its registration name).
@@ -467,6 +397,12 @@ pub trait Force: Debug + Send + Sync {
     /// rotation `(m, mu, phi_th)`) at the frozen attitude: the part of its force that is not
     /// affine in `z` or that depends on time.
     fn add_forcing(&self, _fr: &Frozen, _t: f64, _z: &[Z3; 2], _g: &mut Forcing) {}
+    /// [`Force::add_forcing`] with the component's own states `x` (empty where the caller has
+    /// none): a forcing that reads them, or adds to their rates ([`Forcing::rate_own`]; the
+    /// observer's with thrusters, `observer/thrust.rs`). By default, [`Force::add_forcing`].
+    fn add_forcing_own(&self, fr: &Frozen, t: f64, z: &[Z3; 2], _x: &[f64], g: &mut Forcing) {
+        self.add_forcing(fr, t, z, g);
+    }
     /// The quantities it reports at state `s` (block states `z`, frozen view `fr`) and time
     /// `t` (the pipe's top tension, the moving set point, the thrusters, …), appended to `out`;
     /// the same names at every state.
@@ -561,9 +497,10 @@ pub trait Force: Debug + Send + Sync {
     fn init_own(&self, _s: &VesselState, _x: &mut [f64]) -> Result<()> {
         Ok(())
     }
-    /// The quantities it reports from its own states `x` (beyond the states themselves, which
-    /// the vessel reports from [`Force::own_states`]).
-    fn own_outputs(&self, _fr: &Frozen, _z: &[Z3; 2], _x: &[f64], _out: &mut Vec<Output>) {}
+    /// The quantities it reports from its own states `x` at time `t` (beyond the states
+    /// themselves, which the vessel reports from [`Force::own_states`]).
+    fn own_outputs(&self, _fr: &Frozen, _z: &[Z3; 2], _x: &[f64], _t: f64, _out: &mut Vec<Output>) {
+    }
     /// Set the state variables it owns from the rest of the state (a consistent start).
     fn init_state(&self, _s: &mut VesselState) {}
     /// Restore, after a step, an invariant of the exact flow that involves the component's own

@@ -35,15 +35,19 @@
 //! momenta in flow S2 as one linear system ([`OwnLinear`], exact or collocated: the
 //! composition's order holds for the coupled vessel–observer system).
 //!
+//! With thrusters the hull gets what they deliver and ν̂ is driven by it, with back-calculation
+//! on `q` if asked for: a forcing of flow S2 on the rows' demand (`observer/thrust.rs`).
+//!
 //! Ledger: the observer's states are information, not energy: they store nothing of H. The
-//! controller's force on the hull is the port `control` (supplied): its power `ν·τ` booked
-//! exactly along the flow. The guarantee is the paper's for a port: the vessel's energy
+//! controller's force on the hull is the port `control` (supplied; with thrusters, `thrusters`:
+//! what they deliver): its power `ν·τ` booked exactly along the flow. The guarantee is the paper's for a port: the vessel's energy
 //! changes by what the ports supply less what it dissipates, to round-off.
 
 use super::sensors::{self, Sensors};
 use parts::{gains, states};
 
 mod parts;
+mod thrust;
 use super::{Frozen, Output, OwnLinear, OwnState, HELD};
 use crate::error::Error;
 use crate::flows::collocation::Z3;

@@ -31,6 +31,7 @@
 //! port term, not dissipation).
 
 use super::anti_windup::{self, AntiWindup, PidGains};
+mod outputs;
 use super::observer::{self, Observer};
 use super::thrusters::{self, Thrusters};
 use super::{Force, Forcing, Frozen, Output, OwnLinear, OwnState, Rows, S2Builder, Sys};
@@ -106,15 +107,15 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     p.declare("observer");
     let observer = match p.choice("control", "feedback", &["true_state", "observer"])? {
         "observer" => {
-            for (what, there) in [
-                ("[setpoint] (a moving set point)", setpoint.is_some()),
-                ("[thrusters]", thrusters.is_some()),
-            ] {
-                if there {
-                    return Err(Error::InvalidInput(format!(
-                        "control.feedback = \"observer\" does not yet take {what}: the controller on the observer's estimates acts unlimited on a fixed set point (docs/model.md §5.20); remove {what} or use feedback = \"true_state\""
-                    )));
-                }
+            if setpoint.is_some() {
+                return Err(Error::InvalidInput(
+                    "control.feedback = \"observer\" does not yet take [setpoint] (a moving set point): the controller on the observer's estimates holds a fixed set point (docs/model.md §5.20); remove [setpoint] or use feedback = \"true_state\"".into(),
+                ));
+            }
+            if thrusters.as_ref().is_some_and(|th| th.has_memory()) {
+                return Err(Error::InvalidInput(
+                    "control.feedback = \"observer\" does not take thrusters that keep a memory (thrusters.unit[*].thrust_rate, turn_rate, stuck_at): their memory is kept from the demand on the vessel's state, not the observer's; remove them (a failure with the observer: lost_at) or use feedback = \"true_state\"".into(),
+                ));
             }
             let gains = observer::Gains {
                 kp: [kp_translational, kp_rotational],
@@ -337,119 +338,18 @@ impl Force for Pid {
     /// what they deliver in surge, sway and yaw, each thruster's thrust and angle, and the
     /// utilisation.
     fn outputs(&self, fr: &Frozen, z: &[Z3; 2], s: &VesselState, t: f64, out: &mut Vec<Output>) {
-        if let Some(all) = &self.thrusters {
-            let th = all.at(t);
-            let (f, m) = if fr.control_on {
-                self.demand(fr, t, z)
-            } else {
-                (Vector3::zeros(), Vector3::zeros())
-            };
-            let tau = Vector3::new(f.x, f.y, m.z);
-            let a = match fr.actuators.n {
-                0 => th.allocate(&tau),
-                _ => th.allocate_limited(&tau, &fr.actuators, t - fr.actuators.t),
-            };
-            for (k, (dof, unit)) in [("surge", "N"), ("sway", "N"), ("yaw", "N m")]
-                .iter()
-                .enumerate()
-            {
-                out.push(Output::new(
-                    format!("commanded_{dof}"),
-                    unit,
-                    format!("controller's demand in {dof} (body frame)"),
-                    a.commanded[k],
-                ));
-                out.push(Output::new(
-                    format!("delivered_{dof}"),
-                    unit,
-                    format!("thrust delivered in {dof} (body frame)"),
-                    a.delivered[k],
-                ));
-            }
-            out.push(Output::new(
-                "thrust_utilisation",
-                "1",
-                "largest thrust of a thruster over its limit",
-                a.utilisation,
-            ));
-            for (i, u) in th.units.iter().enumerate() {
-                out.push(Output::new(
-                    format!("thruster{i}_thrust"),
-                    "N",
-                    format!("thrust of thruster {i} ({})", u.kind.name()),
-                    a.thrust[i],
-                ));
-                out.push(Output::new(
-                    format!("thruster{i}_available"),
-                    "1",
-                    format!("whether thruster {i} answers the allocation (0 once lost or stuck: its lost_at, stuck_at)"),
-                    f64::from(u8::from(all.available(i, t))),
-                ));
-                out.push(Output::new(
-                    format!("thruster{i}_angle"),
-                    "degree",
-                    format!("direction of the force of thruster {i} in the body's x-y plane"),
-                    a.angle[i].to_degrees(),
-                ));
-            }
+        // On the observer's estimates the demand is read from its states (`own_outputs`).
+        if self.observer.is_none() {
+            self.thruster_outputs(fr, t, &self.demand_tau(fr, t, z), out);
         }
-        let Some(r) = &self.setpoint else {
-            return;
-        };
-        let d = r.at(t);
-        let (ex, ey) = (s.x.x - d.value[0], s.x.y - d.value[1]);
-        let off = ex.hypot(ey);
-        // Across and along the route (left of the route positive; along: ahead positive).
-        let (cross, along) = match r.route_direction(t) {
-            Some([ux, uy]) => (ux * ey - uy * ex, ux * ex + uy * ey),
-            None => (off, 0.0),
-        };
-        for (name, unit, long_name, value) in [
-            (
-                "setpoint_x",
-                "m",
-                "desired position x from the reference model (spatial)",
-                d.value[0],
-            ),
-            (
-                "setpoint_y",
-                "m",
-                "desired position y from the reference model (spatial)",
-                d.value[1],
-            ),
-            (
-                "setpoint_heading",
-                "rad",
-                "desired heading (yaw) from the reference model",
-                d.value[5],
-            ),
-            (
-                "setpoint_offset",
-                "m",
-                "horizontal distance of the vessel from the desired position",
-                off,
-            ),
-            (
-                "route_cross_track",
-                "m",
-                "vessel's offset across the route from the desired position (left positive)",
-                cross,
-            ),
-            (
-                "route_along_track",
-                "m",
-                "vessel's offset along the route from the desired position (ahead positive)",
-                along,
-            ),
-        ] {
-            out.push(Output::new(name, unit, long_name, value));
-        }
+        self.setpoint_outputs(s, t, out);
     }
     /// The moving set point's part (what `(x_d(t), θ_d(t))` and their rates change in the
     /// controller's force and in the integral states' rates), and, with thrusters, the whole
     /// force as they deliver it.
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
-        if !fr.control_on {
+        // On the observer's estimates the forcing reads its states (`add_forcing_own`).
+        if !fr.control_on || self.observer.is_some() {
             return;
         }
         let mv = self.moving(fr, t);
@@ -487,11 +387,25 @@ impl Force for Pid {
             }
         }
     }
+    /// On the observer's estimates with thrusters: the thrusters' forcing from its states
+    /// (`observer/thrust.rs`); otherwise [`Force::add_forcing`].
+    fn add_forcing_own(&self, fr: &Frozen, t: f64, z: &[Z3; 2], x: &[f64], g: &mut Forcing) {
+        match (&self.observer, &self.thrusters) {
+            (Some(o), Some(all)) => {
+                let back = self
+                    .anti_windup
+                    .as_ref()
+                    .map(|a| Vector3::new(a.gain[0].x, a.gain[0].y, a.gain[1].z));
+                o.add_thrust_forcing(fr, t, x, all, back.as_ref(), g);
+            }
+            _ => self.add_forcing(fr, t, z, g),
+        }
+    }
     fn accounts(&self) -> &'static [Account] {
-        if self.observer.is_some() {
-            &OBSERVER_ACCOUNTS
-        } else if self.thrusters.is_some() {
+        if self.thrusters.is_some() {
             &THRUSTER_ACCOUNTS
+        } else if self.observer.is_some() {
+            &OBSERVER_ACCOUNTS
         } else {
             &ACCOUNTS
         }
@@ -554,9 +468,11 @@ impl Force for Pid {
         let loss = self.thrusters.as_ref().and_then(|th| th.next_loss(t));
         sample.into_iter().chain(loss).reduce(f64::min)
     }
-    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], out: &mut Vec<Output>) {
+    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], t: f64, out: &mut Vec<Output>) {
         if let Some(o) = &self.observer {
             o.outputs(fr, z, x, out);
+            // With thrusters: the demand from the estimates, and what they deliver.
+            self.thruster_outputs(fr, t, &o.demand(fr, x), out);
         }
     }
     fn add_s2(&self, fr: &Frozen, b: &mut S2Builder) {

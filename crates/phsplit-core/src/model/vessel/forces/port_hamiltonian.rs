@@ -431,7 +431,7 @@ impl Force for PortHamiltonian {
         let x = DVector::from_column_slice(x);
         0.5 * x.dot(&(&self.q * &x))
     }
-    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], out: &mut Vec<Output>) {
+    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], _t: f64, out: &mut Vec<Output>) {
         let nu = fr.nu(z);
         let (u, y) = self.io(x, &nu);
         let name = self.name;

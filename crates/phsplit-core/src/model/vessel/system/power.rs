@@ -40,7 +40,7 @@ impl VesselSystem<'_> {
         let z = self.blocks_of(s);
         let mut w = self.power_at(&b, &z);
         if self.forced {
-            let g = self.forcing(&fr, t, &z);
+            let g = self.forcing(&fr, t, &z, &s.own);
             w += self.forcing_power(&[&g], &z);
         }
         w

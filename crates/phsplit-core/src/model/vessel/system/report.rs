@@ -32,7 +32,7 @@ impl VesselSystem<'_> {
                     *v,
                 ));
             }
-            f.own_outputs(&fr, &z, &s.own[r], &mut out);
+            f.own_outputs(&fr, &z, &s.own[r], t, &mut out);
         }
         out
     }
@@ -50,7 +50,7 @@ impl VesselSystem<'_> {
         let booked = b.booked.as_deref().expect("built with the ledger");
         let z = self.blocks_of(s);
         let nu = self.vessel.body.velocity(&s.p, &s.m);
-        let g = self.forcing(&fr, t, &z);
+        let g = self.forcing(&fr, t, &z, &s.own);
         let mut f: Vec<[Vector3<f64>; 2]> = (0..self.accounts.len())
             .map(|k| {
                 [
@@ -86,13 +86,18 @@ impl VesselSystem<'_> {
             let booked = b.booked.as_deref().expect("assembled with the ledger");
             let mut g = Forcing::new();
             let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+            let mut off = 0;
             for (f, &base) in self.vessel.forces.iter().zip(&self.bases) {
+                let n = f.own_states().len();
+                off += n;
                 if !controls(f.as_ref()) {
                     continue;
                 }
                 if f.forced() {
                     g.base = base;
-                    f.add_forcing(fr, t, &z, &mut g);
+                    g.own_base = off - n;
+                    let own = s.own.get(off - n..off).unwrap_or(&[]);
+                    f.add_forcing_own(fr, t, &z, own, &mut g);
                 }
                 for (i, a) in f.accounts().iter().enumerate() {
                     if a.role == Role::Control {

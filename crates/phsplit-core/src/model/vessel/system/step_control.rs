@@ -81,7 +81,7 @@ impl VesselSystem<'_> {
             ));
         }
         (self.actuators > 0).then(|| {
-            "rate-limited thrusters (thrusters.unit[*].thrust_rate, turn_rate) keep a memory from step to step that the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...), or remove the rate limits".into()
+            "rate-limited thrusters (thrusters.unit[*].thrust_rate, turn_rate) and stuck ones (stuck_at) keep a memory from step to step that the Runge–Kutta kernel does not carry: use a splitting method (lie, sp2, sp4, ...), or remove them".into()
         })
     }
 }

@@ -347,7 +347,7 @@ impl Force for LumpedPipe {
         }
         Ok(())
     }
-    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], out: &mut Vec<Output>) {
+    fn own_outputs(&self, fr: &Frozen, z: &[Z3; 2], x: &[f64], _t: f64, out: &mut Vec<Output>) {
         let c = &self.chain;
         let n = c.segments;
         let t = self.tensions(x);

@@ -329,7 +329,7 @@ impl VesselSystem<'_> {
         let mut fixed: [Forcing; 3] = std::array::from_fn(|_| Forcing::new());
         if self.forced_timed {
             for i in 0..s {
-                self.add_forcing_of(fr, t + nodes[i] * h, z0, Some(false), &mut fixed[i]);
+                self.add_forcing_of(fr, t + nodes[i] * h, z0, &[], Some(false), &mut fixed[i]);
             }
         }
         // `g[i].g` is the whole stage forcing (the fixed part's field, then the state's parts
@@ -358,6 +358,7 @@ impl VesselSystem<'_> {
                             fr,
                             t + nodes[i] * h,
                             &stage_z[i],
+                            &[],
                             Some(true),
                             &mut g[i],
                         );
@@ -429,7 +430,14 @@ impl VesselSystem<'_> {
             for i in 0..s {
                 g[i].clear();
                 g[i].g = fixed[i].g;
-                self.add_forcing_of(fr, t + nodes[i] * h, &stage_z[i], Some(true), &mut g[i]);
+                self.add_forcing_of(
+                    fr,
+                    t + nodes[i] * h,
+                    &stage_z[i],
+                    &[],
+                    Some(true),
+                    &mut g[i],
+                );
                 gt[i] = mul6(&to_six(&g[i].g), &inv);
                 y1 = axpy(&y1, &axpy(&field(&ys[i]), &gt[i], 1.0), h * bw[i]);
             }
