@@ -1919,3 +1919,60 @@ CATALOGUE += [
     Bad("a scenario table given twice", scenario('[simulation]\nh = 1.0\n[simulation]\nmethod = "sp2"\n'), P,
         ("the table [simulation] is given twice", "line 3")),
 ]
+
+
+def _sol():
+    return phsplit.simulate(phsplit.Vessel.paper(), (0.0, 5.0), 0.5, "sp2")
+
+
+def _garbage_sweep_store():
+    with tempfile.TemporaryDirectory() as d:
+        os.makedirs(os.path.join(d, "store"))
+        with open(os.path.join(d, "store", "sweep.json"), "w") as f:
+            f.write("garbage{")
+        return phsplit.open_sweep(os.path.join(d, "store"))
+
+
+_WAVES = ('vessel = "paper"\n[environment.waves]\nhydro = "paper_box_capytaine.nc"\nsymmetric = true\n'
+          'omega_range = [0.35, 1.9]\ndirection = 180.0\nseed = 1\ncomponents = 20\n')
+
+CATALOGUE += [
+    Bad("observer bias bandwidth beside both gains", _observer(
+        "bias_bandwidth = 0.1\nvelocity_gain = [1e6, 1e6, 1e9]\nbias_gain = [1e4, 1e4, 1e7]\n"), E,
+        ("observer.bias_bandwidth", "would not act")),
+    Bad("wind centroid without a ship type", _windy(centroid_x=5.0), E, ("environment.wind.centroid_x", "ship_type")),
+    Bad("gust components without a gust spectrum", _windy(spectrum='"none"', components=50), E,
+        ("environment.wind.components", "spectrum = 'none'")),
+    Bad("JONSWAP's gamma with Pierson-Moskowitz", scenario(
+        _WAVES + 'hs = 2.0\ntp = 9.0\nspectrum = "pierson-moskowitz"\ngamma = 2.0\n'), E,
+        ("environment.waves.gamma", "'pierson-moskowitz'")),
+    Bad("a sea steeper than breaking waves", scenario(_WAVES + "hs = 25.0\ntp = 3.0\n"), E,
+        ("environment.waves", "steepness", "1/7")),
+    Bad("capability failure naming a thruster twice", _cap(failures=[[0, 0]]), E, ("failures", "twice in one")),
+    Bad("frequency-domain RAO of a negative amplitude", lambda: phsplit.seakeeping.frequency_rao(
+        phsplit.Vessel.paper(), 0.56, 90.0, amplitude=-1.0), E, ("frequency_rao: amplitude", "positive")),
+    Bad("time-domain RAO over half a period", lambda: phsplit.seakeeping.time_rao(
+        phsplit.Vessel.paper(), {}, 0.56, 90.0, periods=0.5), E, ("time_rao: periods", ">= 1")),
+    Bad("Harris spectrum of a negative wind", lambda: phsplit.sea.harris(np.array([0.01]), -5.0), E,
+        ("harris: speed", "> 0")),
+    Bad("NPD spectrum below the sea", lambda: phsplit.sea.npd(np.array([0.01]), 10.0, height=-1.0), E,
+        ("npd: height", "> 0")),
+    Bad("fluid-memory block of an unknown kind", lambda: phsplit.radiation.block_matrices("spring", [1, 2, 0.5, 0.1]),
+        E, ("kind", "oscillator, ladder", "'spring'")),
+    Bad("natural periods with the controller as text", lambda: phsplit.Vessel.paper().natural_periods(control="yes"),
+        E, ("natural_periods: control", "True or False")),
+    Bad("compare a result with text", lambda: phsplit.results.compare(_sol().to_xarray(), "x"), E,
+        ("compare: b", "xarray.Dataset", "str")),
+    Bad("a sweep store whose sweep.json is damaged", _garbage_sweep_store, E, ("sweep.json", "damaged")),
+    Bad("shift matrix of two numbers", lambda: phsplit.hydro.shift_matrix([1.0, 2.0]), E,
+        ("shift_matrix: r", "three finite numbers")),
+    Bad("drift over a zero frequency", lambda: phsplit.seakeeping.drift(_sol(), 0.0, 10.0), E,
+        ("drift: omega", "positive")),
+    Bad("a state past the saved ones", lambda: _sol().state(100), E, ("state: i", "from -11 to 10", "100")),
+    Bad("a state at a fractional index", lambda: _sol().state(1.5), E, ("state: i", "whole number", "1.5")),
+    Bad("method information of a number", lambda: phsplit.method_info(42), E, ("method_info", "sp4", "int")),
+    Bad("a scenario that is a number", lambda: phsplit.load_scenario(42), E, ("scenario", "str", "int")),
+    Bad("rerun of a capability result", lambda: phsplit.rerun(
+        phsplit.capability("dp-capability", directions=[0.0], failures="none")), E,
+        ("DP capability", "nothing to repeat")),
+]

@@ -313,3 +313,25 @@ def test_headings_and_euler_angles_in_degrees(tmp_path):
     f.write_text('[initial]\neuler_deg = "north"\n')
     with pytest.raises(phsplit.InvalidInputError, match="initial.euler_deg must be a list of finite numbers"):
         phsplit.load_scenario(str(f))
+
+
+def test_settings_that_cannot_act_are_reported():
+    """A setting the run leaves without effect is said (SettingWarning), not dropped: a chosen
+    controller start or a set point's start after the run's end, and a splitting method's flow
+    choices (outer, linear_flow) with Runge-Kutta; the default start of a short run is not."""
+    import warnings
+
+    v = phsplit.Vessel.paper()
+    with pytest.warns(phsplit.SettingWarning, match="control_start = 100 s is after the run's end"):
+        phsplit.simulate(v, (0.0, 5.0), 0.5, "sp2", control_start=100.0)
+    for kw, word in (({"outer": "conservative"}, "outer = 'conservative'"), ({"linear_flow": "exact"}, "linear_flow")):
+        with pytest.warns(phsplit.SettingWarning, match=word):
+            phsplit.simulate(v, (0.0, 2.0), 0.5, "rk4", **kw)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", phsplit.SettingWarning)
+        phsplit.simulate(v, (0.0, 5.0), 0.5, "sp2")            # the default start, past a short run
+        phsplit.simulate(v, (0.0, 2.0), 0.5, "rk4")            # the default flows
+    d = phsplit.load_scenario("pipelay").vessel.to_dict()
+    d["setpoint"]["start_time"] = 1e5
+    with pytest.warns(phsplit.SettingWarning, match="setpoint.start_time = 100000 s is after the run's end"):
+        phsplit.simulate(phsplit.Vessel.from_dict(d), (0.0, 2.0), 0.5, "sp2")

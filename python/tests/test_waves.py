@@ -339,6 +339,6 @@ def test_the_default_spectral_range_stays_inside_the_dataset():
     assert 0.5 * 2 * np.pi / 6.0 <= min(w["frequencies"]) and max(w["frequencies"]) <= 2.0
     a = np.asarray(w["amplitudes"])
     assert abs(4.0 * np.sqrt(np.sum(a ** 2) / 2.0) - 3.0) < 0.15   # Hs = 4 sqrt(m0) of the realisation
-    d["environment"]["waves"]["tp"] = 1.5
+    d["environment"]["waves"].update(tp=1.5, hs=0.1)   # a short swell, not a breaking sea
     with pytest.raises(phsplit.InvalidInputError, match=r"environment.waves: the spectrum's range .* give omega_range"):
         scenario.from_dict(d, scenario.resolve("dp-weather"))

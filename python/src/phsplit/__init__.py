@@ -64,6 +64,9 @@ from .simulate import (Ledger, ModelRangeWarning, PassivityWarning, SettingWarni
 
 def method_info(name: str) -> dict:
     """Order, stages, citation and passivity guarantee of a method (see ``METHODS``)."""
+    if not isinstance(name, str):
+        raise InvalidInputError(f"method_info takes a method's name, one of {', '.join(METHODS)}; got "
+                                f"{type(name).__name__} {name!r}")
     return dict(_method_info(name))
 
 

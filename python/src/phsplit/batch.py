@@ -70,7 +70,11 @@ def _resolve(d: dict, key: str) -> list[str | int]:
     segs: list[str | int] = []
     if m:
         segs = [m.group(1)] + [g1 if g1 else int(g2) for g1, g2 in _SEGMENT.findall(m.group(2))]
-    if not m or not isinstance(segs[1], str) or not isinstance(d.get(segs[0]), dict) or segs[1] not in d[segs[0]]:
+    # A key of a table the vessel has may be absent from its dict (left at its default): the
+    # vessel file's reader checks the name, as for a key of a table in a list.
+    absent_ok = len(segs) == 2 and isinstance(d.get(segs[0]), dict) and bool(d[segs[0]])
+    if not m or not isinstance(segs[1], str) or not isinstance(d.get(segs[0]), dict) or (
+            segs[1] not in d[segs[0]] and not absent_ok):
         valid = sorted(f"{s}.{k}" for s in d if isinstance(d[s], dict) for k in d[s])
         raise _core.InvalidInputError(f"unknown parameter {key!r}; {_SHAPES}, one of: {', '.join(valid)}")
     cur: object = d
@@ -87,7 +91,8 @@ def _resolve(d: dict, key: str) -> list[str | int]:
                 what = ("a list: give an index there" if isinstance(cur, (list, tuple))
                         else "a number: end the path there")
                 raise _core.InvalidInputError(f"parameter {key!r}: {where} is {what}")
-            new_key = seg not in cur and n == len(segs) - 1 and n >= 3 and isinstance(segs[n - 1], int)
+            new_key = seg not in cur and n == len(segs) - 1 and (
+                (n >= 3 and isinstance(segs[n - 1], int)) or (n == 1 and absent_ok))
             if seg not in cur and not new_key:
                 raise _core.InvalidInputError(f"unknown parameter {key!r}: {where} has no {seg!r}; it has "
                                               f"{', '.join(sorted(cur))}")
@@ -144,7 +149,14 @@ def with_parameters(base: Vessel, params: Mapping[str, float]) -> Vessel:
                     f"{segs[0]}.{segs[1]} to different values ({mirrored[entry][1]} and {float(value)})")
             mirrored[entry] = (key, float(value))
             d[segs[0]][segs[1]][segs[3]][segs[2]] = float(value)
-    return Vessel.from_dict(d, f"{base.source} with {dict(params)}")
+    try:
+        return Vessel.from_dict(d, f"{base.source} with {dict(params)}")
+    except _core.ScenarioParseError as e:
+        absent = [k for k in params if isinstance(k, str) and "." in k and k.split(".")[1].split("[")[0]
+                  not in base.to_dict().get(k.split(".")[0], {})]
+        if absent and str(e).startswith("unknown field"):
+            raise _core.InvalidInputError(f"unknown parameter {absent[0]!r}: {e}") from None
+        raise
 
 
 def _number_or_nan(v) -> float:

@@ -298,6 +298,8 @@ def _cases(failures: Any, n: int) -> list[tuple[str, list[int]]]:
         bad = [int(i) for i in g if not 0 <= int(i) < n]
         if bad:
             _bad("failures", f"thruster index {bad[0]} does not exist (the vessel has {n} thrusters, 0..{n - 1})")
+        if len({int(i) for i in g}) != len(g):
+            _bad("failures", f"{g!r} names a thruster twice in one failure case; each thruster once")
         g = sorted({int(i) for i in g})
         if any(c[1] == g for c in out):
             _bad("failures", f"names the failure of thruster(s) {g} twice; each failure case once")

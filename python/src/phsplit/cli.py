@@ -455,7 +455,9 @@ def _simulate(args) -> int:
     from .runner import warn_if_timed_settings_idle
     from .settings import settings_to_toml
 
-    warn_if_timed_settings_idle(sc.vessel, sc.settings.t_span, stacklevel=2)
+    used = sc.settings.checked()
+    warn_if_timed_settings_idle(sc.vessel, used["t_span"], stacklevel=2, control_start=used["control_start"],
+                                used=used)
     bar = _progress_bar(n)
     try:
         # Adaptive steps run as one call: a cut would restart the step-size controller.

@@ -513,7 +513,13 @@ def shift_matrix(r) -> np.ndarray:
     """``T = [[I, S(r)], [0, I]]``: generalised velocities at a point P to those at the point O
     with ``r = P − O`` (``v_O = v_P + S(r) ω``, ``S(r) ω = r × ω``); loads go from O to P as
     ``Tᵀ τ`` and matrices as ``Tᵀ A T`` (Fossen 2021, the system transformation matrix H(r))."""
-    r = np.asarray(r, dtype=float)
+    try:
+        r = np.asarray(r, dtype=float)
+    except (TypeError, ValueError):
+        r = np.full(1, np.nan)
+    if r.shape != (3,) or not np.all(np.isfinite(r)):
+        raise _err("shift_matrix: r must be three finite numbers (m, the point's offset), got "
+                   f"{r.tolist() if r.ndim else r!r}")
     s = np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
     t = np.eye(6)
     t[0:3, 3:6] = s

@@ -141,6 +141,8 @@ def block_matrices(kind: str, par) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
     """``(J, R, Q, i)`` of a block. The ladder's parameters are ``(ω₁, ω₂, m₂, γ)``: ``k₁ = ω₁²``,
     ``k₁₂ = m₂ ω₂²``, ``c = γ m₂`` (so that box bounds on them bound the block's frequencies and its
     decay rate)."""
+    if kind not in BLOCK_KINDS:
+        raise _err(f"a block's kind must be one of {', '.join(BLOCK_KINDS)}, got {kind!r}")
     if kind == "oscillator":
         wk, zk = par
         return (np.array([[0.0, 1.0], [-1.0, 0.0]]), np.diag([0.0, 2.0 * zk * wk]), np.diag([wk * wk, 1.0]), 1)

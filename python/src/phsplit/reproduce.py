@@ -34,6 +34,7 @@ import numpy as np
 
 from . import _core, cf
 from .runner import StepSizeWarning
+from .settings import Settings
 from .simulate import simulate
 from .vessel import Vessel
 
@@ -42,7 +43,9 @@ def simulate_as_printed(*args, **kw):
     """The paper's schemes as printed: without the projection onto the restoring invariant
     that phsplit applies by default (docs/model.md §3.6), so that the report measures the
     methods the paper describes, with its exact flow S2 (§3.4.2)."""
-    kw.setdefault("linear_flow", "exact")
+    method = kw.get("method", args[3] if len(args) > 3 else Settings.method)
+    if _core.method_info(method)["kind"] == "splitting":
+        kw.setdefault("linear_flow", "exact")
     sol = simulate(*args, project_invariants=False, **kw)
     if sol.status == "interrupted":
         # Ctrl-C (or SIGTERM) while the core ran: it returned what it had. The study stops here,

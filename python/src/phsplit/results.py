@@ -132,6 +132,9 @@ def check_record(ds) -> tuple[Vessel, Settings, np.ndarray, list[int]]:
     the vessel, the settings, the initial state (a finite vector of the vessel's state size) and
     the calls (``phsplit_chunks``, adding up to the settings' steps). Raises
     :class:`phsplit.InvalidInputError` naming the damaged part."""
+    if "wind_speed_limit" in ds:
+        raise _core.InvalidInputError("the result is a DP capability (phsplit.capability), not a run: there is nothing "
+                                      "to repeat; compute it again with phsplit.capability")
     if "case" in ds.dims:
         raise _core.InvalidInputError(
             f"the result holds {ds.sizes['case']} cases of a sweep (a batch file of a sweep store); rerun one "
@@ -205,6 +208,12 @@ def compare(a, b) -> list[tuple[str, float]]:
     """The variables of ``a`` whose values differ from ``b``'s (NaN equal to NaN), with the
     largest absolute difference; ``[]`` when every number agrees to the last bit. Variables
     present in only one of them are reported with ``inf``."""
+    import xarray as xr
+
+    for name, ds in (("a", a), ("b", b)):
+        if not isinstance(ds, xr.Dataset):
+            raise _core.InvalidInputError(f"compare: {name} must be an xarray.Dataset (a result), got "
+                                          f"{type(ds).__name__}")
     diffs = []
     for name in sorted(set(a.data_vars) | set(b.data_vars) | {"time"}):
         if name not in a.variables or name not in b.variables:

@@ -91,13 +91,32 @@ def _warn_if_energy_created(raw: dict, info: dict, outer: str, e: np.ndarray, st
         "'sp2'/'lie', whose positive steps are passive for any h (Prop. 2.2)."), stacklevel=user_stacklevel())
 
 
-def warn_if_timed_settings_idle(vessel: Vessel, t_span: tuple[float, float], stacklevel: int) -> None:
-    """A :class:`SettingWarning` for each timed setting of the vessel that this run's span leaves
-    without effect: a thruster lost (``lost_at``) after the run's end, a sensor dropout wholly
-    before its start or after its end. The vessel is the same for any span (a run cut into parts
-    sees each part's), so the whole run's span is judged here, where the user gives it."""
+def warn_if_timed_settings_idle(vessel: Vessel, t_span: tuple[float, float], stacklevel: int,
+                                control_start: float | None = None, used: dict | None = None) -> None:
+    """A :class:`SettingWarning` for each timed setting that this run's span leaves without
+    effect: the controller's start (``control_start``) or a moving set point's start
+    (``setpoint.start_time``) after the run's end, a thruster lost or stuck (``lost_at``,
+    ``stuck_at``) after it, a sensor dropout wholly before its start or after its end. The vessel
+    is the same for any span (a run cut into parts sees each part's), so the whole run's span is
+    judged here, where the user gives it."""
     t0, t1 = float(t_span[0]), float(t_span[1])
+    if used is not None and _core.method_info(used["method"])["kind"] != "splitting":
+        for key, default in (("outer", Settings.outer), ("linear_flow", Settings.linear_flow)):
+            if used[key] != default:
+                warnings.warn(SettingWarning(
+                    f"{key} = {used[key]!r} chooses among a splitting method's flows, and {used['method']} is "
+                    f"explicit Runge-Kutta: it does not act in this run"), stacklevel=user_stacklevel())
+    # The default start (the paper's 50 s) is not the user's choice: a short run with it is no slip.
+    if control_start is not None and control_start > t1 and control_start != Settings.control_start:
+        warnings.warn(SettingWarning(
+            f"control_start = {control_start:g} s is after the run's end ({t1:g} s): the controller does not act in "
+            f"this run (control_start = None says so)"), stacklevel=user_stacklevel())
     d = vessel.to_dict()
+    start = (d.get("setpoint") or {}).get("start_time")
+    if isinstance(start, (int, float)) and not isinstance(start, bool) and start > t1 and "control" in d:
+        warnings.warn(SettingWarning(
+            f"setpoint.start_time = {start:g} s is after the run's end ({t1:g} s): the set point does not move in "
+            f"this run"), stacklevel=user_stacklevel())
     for i, unit in enumerate((d.get("thrusters") or {}).get("unit") or []):
         for key, what in (("lost_at", "lost"), ("stuck_at", "stuck")):
             at = unit.get(key) if isinstance(unit, dict) else None

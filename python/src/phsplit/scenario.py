@@ -494,6 +494,9 @@ def vessel_named(name: str, base_dir: str = ".") -> Vessel:
 def load(path: str | os.PathLike[str], vessel: str | None = None) -> Scenario:
     """Read and validate a scenario file, or a shipped scenario by name (``"pipelay"``);
     ``vessel`` replaces its vessel (see :func:`from_dict`)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise _core.InvalidInputError(f"a scenario is a file's path or a shipped scenario's name (a str), got "
+                                      f"{type(path).__name__} {path!r}")
     p = resolve(path)
     if not os.path.exists(p) and os.fspath(path) == p and os.sep not in p and not p.endswith(".toml"):
         names = ", ".join(shipped())

@@ -230,10 +230,32 @@ def sea_state(table: dict) -> SeaState:
             raise _core.ScenarioParseError(f"missing field {k!r} in [environment.waves] "
                                            f"({'significant wave height, m' if k == 'hs' else 'peak period, s'})")
     kw = {k: table[k] for k in allowed if k in table}
+    if "gamma" in kw and kw.get("spectrum", "jonswap") != "jonswap":
+        raise _core.InvalidInputError(f"environment.waves.gamma is the JONSWAP spectrum's peak enhancement, and this "
+                                      f"sea's spectrum is {kw['spectrum']!r}: remove gamma, or set spectrum = 'jonswap'")
     if "omega_range" in kw:
         _check_range("waves", kw["omega_range"])
         kw["omega_range"] = tuple(kw["omega_range"])
-    return SeaState(**kw)
+    sea = SeaState(**kw)
+    steep = steepness(sea.hs, sea.tp)
+    if steep > MAX_STEEPNESS:
+        raise _core.InvalidInputError(
+            f"environment.waves: hs = {sea.hs:g} m at tp = {sea.tp:g} s is a sea of steepness 2 pi Hs/(g Tp^2) = "
+            f"{steep:.3g}, beyond the 1/7 at which even a regular wave breaks (Michell 1893); lower hs or raise tp "
+            f"(real seas stay below about 1/15)")
+    return sea
+
+
+#: The steepest wave: a regular wave breaks at H/L = 1/7 (J. H. Michell, "The highest waves in
+#: water", Phil. Mag. 36 (1893) 430-437); a sea state's average steepness stays far below it
+#: (about 1/15 at most: DNV-RP-C205, Environmental conditions and environmental loads, 3.5.5).
+MAX_STEEPNESS = 1.0 / 7.0
+
+
+def steepness(hs: float, tp: float, g: float = 9.81) -> float:
+    """A sea state's average steepness ``S_p = 2π Hs / (g Tp²)``, Hs over the deep-water
+    wavelength at the peak period."""
+    return 2.0 * math.pi * hs / (g * tp * tp)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -251,6 +273,9 @@ def harris(f, speed: float, drag: float = 0.002, length: float = 1800.0):
     (values from 0.002 to 0.0026 are in use); its variance is ``6.6775 κ U²`` whatever ``L``.
     (DNV-RP-C205 gives a σ-normalised variant of it; this is the κ form.)"""
     f = np.asarray(f, dtype=float)
+    for name, v in (("speed", speed), ("drag", drag), ("length", length)):
+        if not (_number(v) and v > 0):
+            raise _core.InvalidInputError(f"harris: {name} must be a number > 0, got {v!r}")
     return 4.0 * drag * length * speed / (2.0 + (f * length / speed) ** 2) ** (5.0 / 6.0)
 
 
@@ -263,6 +288,9 @@ def npd(f, speed: float, height: float = 10.0):
     DNV-RP-C205, §2.3; as implemented in OpenFAST TurbSim's ``Spec_API``). Its variance is
     ``(A/c)(1/n) B(1/n, 2/(3n))`` with ``A = 320 (U/10)² (z/10)^0.45``, ``c`` the factor of ``f``
     in ``f̃``."""
+    for name, v in (("speed", speed), ("height", height)):
+        if not (_number(v) and v > 0):
+            raise _core.InvalidInputError(f"npd: {name} must be a number > 0, got {v!r}")
     f = np.asarray(f, dtype=float)
     n = 0.468
     ft = 172.0 * f * (height / 10.0) ** (2.0 / 3.0) * (speed / 10.0) ** -0.75
@@ -358,6 +386,15 @@ def wind(table: dict) -> tuple[dict, dict]:
         raise _core.ScenarioParseError("missing field 'speed' in [environment.wind] (mean wind speed at 10 m, m/s)")
     kw = {k: table[k] for k in own if k in table}
     spectrum = kw.get("spectrum", "npd")
+    if "centroid_x" in table and "ship_type" not in table:
+        raise _core.InvalidInputError("environment.wind.centroid_x places the lateral area for Blendermann's "
+                                      "coefficients of a ship_type; without ship_type nothing reads it: give ship_type, "
+                                      "or remove centroid_x")
+    if spectrum == "none":
+        idle = [k for k in ("components", "seed", "omega_range") if k in kw]
+        if idle:
+            raise _core.InvalidInputError(f"environment.wind.{idle[0]} draws the gusts, and spectrum = 'none' has none: "
+                                          f"remove {', '.join(idle)}, or give a gust spectrum ('npd' or 'harris')")
     for key, used_by in (("drag", "harris"), ("height", "npd")):
         if key in kw and spectrum != used_by:
             raise _core.InvalidInputError(

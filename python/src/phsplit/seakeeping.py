@@ -145,6 +145,8 @@ def frequency_rao(vessel, omega: float, heading: float, dataset=DEFAULT_DATASET,
         raise _err(f"frequency_rao: omega must be a positive number (rad/s), got {omega!r}")
     if not (_real(heading) and math.isfinite(float(heading)) and -360.0 <= float(heading) <= 360.0):
         raise _err(f"frequency_rao: heading must be a number of degrees within ±360, got {heading!r}")
+    if amplitude is not None and not (_real(amplitude) and math.isfinite(float(amplitude)) and float(amplitude) > 0):
+        raise _err(f"frequency_rao: amplitude must be a positive number (m) or None, got {amplitude!r}")
     w, K, Ainf, _, out = data if data is not None else radiation.retardation_data(dataset, vessel=vessel)
     if not w[0] - 1e-9 <= omega <= w[-1] + 1e-9:
         raise _err(f"frequencies: {omega:g} rad/s is outside the dataset's {w[0]:g}-{w[-1]:g} rad/s")
@@ -202,6 +204,10 @@ def time_rao(vessel, waves, omega: float, heading: float, *, amplitude: float = 
     from .simulate import SettingWarning, Vessel, simulate
 
     _vessel(vessel, "time_rao")
+    for name, v, lo in (("amplitude", amplitude, 0.0), ("h", h, 0.0), ("t_end", t_end, 0.0), ("periods", periods, 1.0)):
+        if not (_real(v) and math.isfinite(float(v)) and float(v) >= lo and float(v) > 0):
+            raise _err(f"time_rao: {name} must be a number {'>= 1 (the fit window in periods)' if lo else '> 0'}, "
+                       f"got {v!r}")
     if not isinstance(waves, dict):
         raise _err(f"time_rao: waves must be the transfer functions of waves_table (a dict), got {type(waves).__name__}")
     d = vessel.to_dict()
@@ -232,6 +238,9 @@ def drift(s, omega: float, periods: float) -> float:
     run: the first-order loads on the nonlinear rigid body have a mean part (products of the
     wave-frequency motions and loads, growing as the amplitude squared), and with the
     controller off nothing holds the vessel on station."""
+    for name, v in (("omega", omega), ("periods", periods)):
+        if not (_real(v) and math.isfinite(float(v)) and float(v) > 0):
+            raise _err(f"drift: {name} must be a positive number, got {v!r}")
     t_end = float(s.t[-1])
     keep = s.t >= t_end - periods * 2 * math.pi / omega - 1e-9
     xy = s.x[keep, :2]

@@ -147,7 +147,9 @@ def simulate(
     elif not isinstance(settings, Settings):
         raise _core.InvalidInputError(f"settings must be a phsplit.Settings, got {type(settings).__name__}")
     if not _continuing:
-        warn_if_timed_settings_idle(vessel, settings.checked()["t_span"], stacklevel=4)
+        used = settings.checked()
+        warn_if_timed_settings_idle(vessel, used["t_span"], stacklevel=4, control_start=used["control_start"],
+                                    used=used)
     if isinstance(settings.save_every, float):
         raise _core.InvalidInputError(f"save_every must be an integer >= 1, got {settings.save_every!r}")
     if initial is None:

@@ -192,6 +192,10 @@ class Solution:
         phi_x), as the core takes it, followed by the components' own states (:attr:`own`) and,
         for a vessel with rate-limited thrusters, their memory (:attr:`actuators`), so that a run
         continued from it goes on as one run."""
+        n = len(self.t)
+        if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)) or not -n <= i < n:
+            raise _core.InvalidInputError(f"state: i must be a saved index, a whole number from {-n} to {n - 1} "
+                                          f"(the run saved {n} states), got {i!r}")
         y = np.concatenate([self.p[i], self.m[i], self.Q[i].reshape(-1, order="F"), self.mu[i], self.x[i],
                             self.phi_th[i], self.phi_x[i]])
         tail = [a[i] for a in (self.own, self.actuators) if a is not None]

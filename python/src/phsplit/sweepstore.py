@@ -287,8 +287,14 @@ def open_sweep(store: str | os.PathLike[str]):
     meta = os.path.join(root, "sweep.json")
     if not os.path.isfile(meta):
         raise _core.InvalidInputError(f"{root!r} is not a sweep store (no sweep.json in it)")
-    with open(meta) as f:
-        cases = json.load(f)["cases"]
+    try:
+        with open(meta) as f:
+            cases = json.load(f)["cases"]
+        if not isinstance(cases, dict):
+            raise TypeError
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, KeyError, TypeError):
+        raise _core.InvalidInputError(f"{meta!r} is damaged: a sweep store's sweep.json is the JSON object "
+                                      f"phsplit sweep writes, with its cases") from None
     index = store_index(root)
     opened: dict[str, Any] = {}
     parts, ids, params = [], [], []

@@ -144,6 +144,8 @@ class Vessel:
         """The natural periods (s, ascending) of the vessel's oscillating modes, flow S2
         linearised at the initial attitude (or at ``initial_state(**initial)``'s), with the
         controller on or off. For the paper's vessel: pitch 4.08, heave 4.25, roll 9.21 s."""
+        if not isinstance(control, (bool, np.bool_)):
+            raise _core.InvalidInputError(f"natural_periods: control must be True or False, got {control!r}")
         return list(self._inner.natural_periods(self.initial_state(**initial), bool(control)))
 
     @property

@@ -21,6 +21,11 @@ pub(super) fn gains(
     damping: &Vector3<f64>,
 ) -> crate::Result<(Vector3<f64>, Vector3<f64>)> {
     if let (Some(k4), Some(k3)) = (k4, k3) {
+        if given_b {
+            return Err(Error::InvalidInput(
+                "observer.bias_bandwidth places velocity_gain and bias_gain, and both are given, so it would not act: remove bias_bandwidth, or one of the gains".into(),
+            ));
+        }
         return Ok((k4, k3));
     }
     let mut p4 = Vector3::zeros();
