@@ -1976,3 +1976,34 @@ CATALOGUE += [
         phsplit.capability("dp-capability", directions=[0.0], failures="none")), E,
         ("DP capability", "nothing to repeat")),
 ]
+
+
+def _fmu_at(path, make_dir=None, file=None, load=False, **kw):
+    def run():
+        import phsplit.fmu as fmu
+
+        with tempfile.TemporaryDirectory() as d:
+            if make_dir:
+                os.mkdir(os.path.join(d, make_dir))
+            if file:
+                with open(os.path.join(d, file), "w") as f:
+                    f.write("x")
+            out = os.path.join(d, path) if isinstance(path, str) else path
+            return fmu.export_load(out, **kw) if load else fmu.export(None, out, **kw)
+
+    return run
+
+
+CATALOGUE += [
+    Bad("FMU under a file", _fmu_at("f/x.fmu", file="f"), E, ("out", "is a file, not a folder")),
+    Bad("load FMU under a file", _fmu_at("f/l.fmu", file="f", load=True), E, ("out", "is a file, not a folder")),
+    Bad("FMU onto a folder", _fmu_at("adir.fmu", make_dir="adir.fmu"), E, ("out", "is a folder")),
+    Bad("load FMU onto a folder", _fmu_at("adir.fmu", make_dir="adir.fmu", load=True), E, ("out", "is a folder")),
+    Bad("FMU at a number", _fmu_at(42), E, ("out must be the .fmu file's path", "42")),
+    Bad("FMU binaries as the CLI's text", _fmu_at("v.fmu", binaries="win64=x.dll"), E,
+        ("binaries must be a mapping", "--binary")),
+    Bad("load FMU binaries as text", _fmu_at("l.fmu", load=True, binaries="win64=x.dll"), E,
+        ("binaries must be a mapping",)),
+    Bad("FMU binary path that is a number", _fmu_at("v.fmu", binaries={"win64": 42}), E,
+        ("binaries must be a mapping", "path")),
+]

@@ -132,8 +132,29 @@ def binary_problem(plat: str, data: bytes) -> str | None:
     return None
 
 
+def check_out(out: Any) -> Path:
+    """Where an FMU is written, checked before it is built: a path (str or os.PathLike) that is not
+    a folder and whose nearest existing ancestor is a folder (the missing ones are made)."""
+    if not isinstance(out, (str, os.PathLike)) or not os.fspath(out):
+        raise _core.InvalidInputError(f"out must be the .fmu file's path, got {out!r}")
+    p = Path(out)
+    if p.is_dir():
+        raise _core.InvalidInputError(f"out {os.fspath(out)!r} is a folder; name the .fmu file to write")
+    parent = p.absolute().parent
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise _core.InvalidInputError(f"out {os.fspath(out)!r} cannot be written: {os.fspath(parent)!r} is a file, "
+                                      f"not a folder")
+    return p
+
+
 def _binaries(extra: Mapping[str, str | os.PathLike[str]] | None) -> dict[str, bytes]:
     """The binaries to pack: the shipped one for this machine, plus ``extra`` (platform -> path)."""
+    if extra is not None and (not isinstance(extra, Mapping) or not all(
+            isinstance(v, (str, os.PathLike)) for v in extra.values())):
+        raise _core.InvalidInputError(f"binaries must be a mapping from platform to a binary's path, e.g. "
+                                      f"{{'win64': 'phsplit_fmu.dll'}} (the CLI's --binary win64=PATH), got {extra!r}")
     out: dict[str, bytes] = {}
     plat = _host_platform()
     shipped = BINARIES / plat / _binary_name(plat)
@@ -301,6 +322,7 @@ def export(scenario: Any = None, out: str | os.PathLike[str] = "vessel.fmu", *,
     """
     from . import scenario as sc
 
+    check_out(out)
     if model_name is not None and (not isinstance(model_name, str) or not model_name.strip()):
         raise _core.InvalidInputError(f"model_name must be a non-empty string (the FMU's name), or None for "
                                       f"phsplit's, got {model_name!r}")
@@ -369,6 +391,7 @@ def export_load(out: str | os.PathLike[str] = "load.fmu", *, force_mean: Sequenc
     means, amplitudes and period are its parameters. Connect its outputs to a vessel FMU's
     ``external_force.*`` and ``external_moment.*`` (see docs/fmu.md for an OSP system structure).
     """
+    check_out(out)
     load = {"force_mean": _vec3("force_mean", force_mean),
             "force_amplitude": _vec3("force_amplitude", force_amplitude),
             "moment_mean": _vec3("moment_mean", moment_mean),
