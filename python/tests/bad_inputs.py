@@ -2007,3 +2007,8 @@ CATALOGUE += [
     Bad("FMU binary path that is a number", _fmu_at("v.fmu", binaries={"win64": 42}), E,
         ("binaries must be a mapping", "path")),
 ]
+
+CATALOGUE += [
+    Bad("the index of a sweep store that does not exist", lambda: __import__("phsplit.sweepstore").sweepstore.store_index("no-such-store"), E,
+        ("sweep store", "'no-such-store'", "not a folder")),
+]

@@ -166,9 +166,12 @@ def store_index(store: str) -> dict[str, tuple[str, int | None]]:
     """Where each stored case of a sweep store is: ``{case id: (file, index along case)}``, the
     index ``None`` for a file of one case (``cases/<id>.nc``), else its place in a batch file
     (``cases/batch_<digest>.nc``). A case stored twice (two sweeps writing one store at once) is
-    taken from the first file in name order."""
+    taken from the first file in name order. A store that does not exist is refused; one not yet
+    written to holds no case."""
     import xarray as xr
 
+    if not isinstance(store, (str, os.PathLike)) or not os.path.isdir(store):
+        raise _core.InvalidInputError(f"the sweep store {store!r} is not a folder (phsplit sweep makes it)")
     d = os.path.join(store, "cases")
     out: dict[str, tuple[str, int | None]] = {}
     if not os.path.isdir(d):
@@ -194,8 +197,9 @@ def store_index(store: str) -> dict[str, tuple[str, int | None]]:
 
 
 def done_cases(store: str) -> set[str]:
-    """The ids of the cases a sweep store holds (in files of one case or in batch files)."""
-    return set(store_index(store))
+    """The ids of the cases a sweep store holds (in files of one case or in batch files); none
+    for a store not made yet."""
+    return set(store_index(store)) if os.path.isdir(store) else set()
 
 
 
