@@ -130,7 +130,7 @@ def test_a_failure_after_the_run_or_a_dropout_outside_it_is_reported(pipelay):
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", phsplit.SettingWarning)
-        phsplit.simulate(late, (0.0, 60.0), 0.5)  # lost within the run: no warning
+        phsplit.simulate(late, (0.0, 700.0), 0.5)  # lost within the run, the set point moving from 600 s: no warning
     obs = phsplit.load_scenario("dp-observer").vessel.to_dict()
     obs["sensors"]["gnss_dropout"] = [[-50.0, -10.0], [1.0, 1.5]]
     obs["sensors"]["gyro_dropout"] = [[30.0, 40.0]]
