@@ -229,6 +229,8 @@ KEYS: dict[str, dict[str, tuple[str, str, str]]] = {
         "direction_towards": ("degrees", "none", "the same as `direction` (give one of the three)"),
         "direction_from": ("degrees", "none", "the direction the waves come from, instead"),
         "spreading": ("-", "none (long-crested)", "exponent `s` of the cos-2s spreading function"),
+        "direction_sampling": ("-", '"quasi_random"', 'with `spreading`: `"quasi_random"` (each component\'s direction at a '
+                               'golden-ratio quantile of the spreading) or `"random"` (independent draws)'),
         "seed": ("-", "0", "the same seed, the same sea"),
         "components": ("-", "200", "number of regular components, 1 to 10,000"),
         "omega_range": ("rad/s", "[0.5, 3] ω_p", "two increasing frequencies > 0; by default, with `hydro`, within the dataset's frequencies"),

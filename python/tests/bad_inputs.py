@@ -1948,6 +1948,13 @@ CATALOGUE += [
         ("environment.waves.gamma", "'pierson-moskowitz'")),
     Bad("a sea steeper than breaking waves", scenario(_WAVES + "hs = 25.0\ntp = 3.0\n"), E,
         ("environment.waves", "steepness", "1/7")),
+    Bad("an unknown way of sampling the directions", scenario(
+        _WAVES + 'hs = 2.0\ntp = 9.0\nspreading = 5.0\ndirection_sampling = "sobol"\n'), E,
+        ("direction_sampling", "'quasi_random', 'random'", "'sobol'")),
+    Bad("direction sampling of a long-crested sea", scenario(_WAVES + 'hs = 2.0\ntp = 9.0\ndirection_sampling = "random"\n'),
+        E, ("environment.waves.direction_sampling", "needs spreading")),
+    Bad("random directions without spreading", lambda: phsplit.sea.SeaState(hs=2.0, tp=9.0, direction_sampling="random"),
+        E, ("direction_sampling = 'random' needs spreading",)),
     Bad("capability failure naming a thruster twice", _cap(failures=[[0, 0]]), E, ("failures", "twice in one")),
     Bad("frequency-domain RAO of a negative amplitude", lambda: phsplit.seakeeping.frequency_rao(
         phsplit.Vessel.paper(), 0.56, 90.0, amplitude=-1.0), E, ("frequency_rao: amplitude", "positive")),

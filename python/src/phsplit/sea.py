@@ -10,8 +10,11 @@ The spectra come from `wavespectra <https://wavespectra.readthedocs.io>`_
 * amplitudes: ``a_k = √(2 S(ω_k) Δω)``, with ``S`` the spectrum per rad/s;
 * phases: uniform on ``[0, 2π)``;
 * directions: the mean direction, or, with ``spreading`` (the exponent ``s`` of the cos-2s
-  spreading function, ``D(θ) ∝ cos^{2s}((θ − θ_mean)/2)``), one random direction per component
-  drawn from it.
+  spreading function, ``D(θ) ∝ cos^{2s}((θ − θ_mean)/2)``), one direction per component (the
+  single-summation model: E. R. Jefferys, "Directional seas should be ergodic", Applied Ocean
+  Research 9 (1987) 186–191), at the quantiles of ``D`` given by a low-discrepancy sequence
+  (``direction_sampling = "quasi_random"``, the default: :func:`_cos2s_quasi`) or drawn
+  independently (``"random"``).
 
 All random numbers come from ``numpy.random.default_rng(seed)``: the same seed gives the same sea.
 The result is the ``[waves]`` table's sea-state keys (``frequencies``, ``amplitudes``, ``phases``,
@@ -27,6 +30,8 @@ from . import _core
 from ._arguments import checked
 
 SPECTRA = ("jonswap", "pierson-moskowitz")
+#: How a short-crested sea's components take their directions (:class:`SeaState`).
+DIRECTION_SAMPLING = ("quasi_random", "random")
 
 
 def _number(v) -> bool:
@@ -100,8 +105,10 @@ class SeaState:
     """A sea state: ``hs`` (m), ``tp`` (s), ``gamma`` (JONSWAP peak enhancement; ignored for
     Pierson–Moskowitz), ``direction`` (degrees, the direction the waves travel towards, spatial,
     from x towards y), ``spreading`` (cos-2s exponent, or None for long-crested waves),
-    ``seed``, ``components`` and the frequency range ``omega_range`` (rad/s; default
-    ``[0.5, 3] ω_p``)."""
+    ``seed``, ``components``, the frequency range ``omega_range`` (rad/s; default
+    ``[0.5, 3] ω_p``) and, with ``spreading``, ``direction_sampling``: ``"quasi_random"`` (the
+    components' directions at low-discrepancy quantiles of the spreading, the default) or
+    ``"random"`` (independent draws)."""
 
     hs: float
     tp: float
@@ -112,6 +119,7 @@ class SeaState:
     seed: int = 0
     components: int = 200
     omega_range: tuple[float, float] | None = None
+    direction_sampling: str = "quasi_random"
 
     def __post_init__(self):
         def bad(msg):
@@ -140,6 +148,12 @@ class SeaState:
             bad(f"seed must be an integer in [0, 2^63), got {self.seed!r}")
         if self.omega_range is not None:
             _check_range("waves", self.omega_range)
+        if self.direction_sampling not in DIRECTION_SAMPLING:
+            bad(f"direction_sampling must be one of {', '.join(repr(s) for s in DIRECTION_SAMPLING)} (how the "
+                f"components' directions sample the spreading), got {self.direction_sampling!r}")
+        if self.direction_sampling != "quasi_random" and self.spreading is None:
+            bad(f"direction_sampling = {self.direction_sampling!r} needs spreading: a long-crested sea's components "
+                f"all travel in the mean direction")
 
     @property
     def omega_p(self) -> float:
@@ -179,19 +193,44 @@ class SeaState:
         phase = rng.uniform(0.0, 2 * np.pi, n)
         if self.spreading is None:
             dirs = np.full(n, float(self.direction))
-        else:
+        elif self.direction_sampling == "random":
             dirs = self.direction + np.degrees(_cos2s_draw(rng, self.spreading, n))
+        else:
+            dirs = self.direction + np.degrees(_cos2s_quasi(rng, self.spreading, n))
         return {"frequencies": omega.tolist(), "amplitudes": amp.tolist(), "phases": phase.tolist(),
                 "directions": dirs.tolist()}
 
 
-def _cos2s_draw(rng, s: float, n: int) -> np.ndarray:
-    """n angles (rad) from D(θ) ∝ cos^{2s}(θ/2) on (−π, π], by inverting its tabulated CDF."""
+def _cos2s_quantiles(s: float, u) -> np.ndarray:
+    """The angles (rad) at the quantiles ``u`` of D(θ) ∝ cos^{2s}(θ/2) on (−π, π], by inverting
+    its tabulated CDF."""
     th = np.linspace(-np.pi, np.pi, 20001)
     d = np.cos(th / 2.0) ** (2.0 * s)
     cdf = np.concatenate([[0.0], np.cumsum(0.5 * (d[1:] + d[:-1]) * np.diff(th))])
     cdf /= cdf[-1]
-    return np.interp(rng.uniform(0.0, 1.0, n), cdf, th)
+    return np.interp(u, cdf, th)
+
+
+def _cos2s_draw(rng, s: float, n: int) -> np.ndarray:
+    """n independent angles (rad) from D(θ) ∝ cos^{2s}(θ/2)."""
+    return _cos2s_quantiles(s, rng.uniform(0.0, 1.0, n))
+
+
+#: The golden ratio's fractional part: the Kronecker sequence ``{u₀ + k g}`` with it has the
+#: lowest discrepancy of all such sequences, its continued fraction being all ones (H. Niederreiter,
+#: *Random Number Generation and Quasi-Monte Carlo Methods*, SIAM, 1992, §3.1).
+GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+def _cos2s_quasi(rng, s: float, n: int) -> np.ndarray:
+    """n angles (rad) at the quantiles ``u_k = {u₀ + k g}`` of D(θ) ∝ cos^{2s}(θ/2), ``u₀``
+    random: consecutive components (neighbours in frequency) spread over the whole distribution,
+    so every band of frequencies carries the directional spectrum, not a handful of random draws
+    of it. A narrow-band response (a lightly damped roll) sees a few dozen components; with
+    independent draws the variance of its realisation scatters by several per cent from seed to
+    seed (docs/explanation/components/waves.md, measured on the OSV)."""
+    u = np.mod(rng.uniform(0.0, 1.0) + GOLDEN * np.arange(n), 1.0)
+    return _cos2s_quantiles(s, u)
 
 
 @checked
@@ -214,7 +253,8 @@ def regular(amplitude: float, omega: float, direction: float = 0.0, phase: float
 def sea_state(table: dict) -> SeaState:
     """A :class:`SeaState` from a scenario's ``[environment.waves]`` keys (unknown keys named;
     the direction by ``direction``/``direction_towards`` or ``direction_from``, degrees)."""
-    allowed = {"hs", "tp", "gamma", "spectrum", "direction", "spreading", "seed", "components", "omega_range"}
+    allowed = {"hs", "tp", "gamma", "spectrum", "direction", "spreading", "seed", "components", "omega_range",
+               "direction_sampling"}
     table = _with_direction(table, "environment.waves")
     allowed_shown = allowed | set(DIRECTION_KEYS)
     unknown = sorted(set(table) - allowed - {"hydro", "symmetric", "hydro_checks", "fluid_memory"})
@@ -230,6 +270,10 @@ def sea_state(table: dict) -> SeaState:
             raise _core.ScenarioParseError(f"missing field {k!r} in [environment.waves] "
                                            f"({'significant wave height, m' if k == 'hs' else 'peak period, s'})")
     kw = {k: table[k] for k in allowed if k in table}
+    if "direction_sampling" in kw and "spreading" not in kw:
+        raise _core.InvalidInputError("environment.waves.direction_sampling needs spreading: a long-crested sea's "
+                                      "components all travel in the mean direction (add spreading, or remove "
+                                      "direction_sampling)")
     if "gamma" in kw and kw.get("spectrum", "jonswap") != "jonswap":
         raise _core.InvalidInputError(f"environment.waves.gamma is the JONSWAP spectrum's peak enhancement, and this "
                                       f"sea's spectrum is {kw['spectrum']!r}: remove gamma, or set spectrum = 'jonswap'")
