@@ -96,6 +96,21 @@ def test_sweep_cli_stores_every_case_once_and_resumes(tmp_path):
     assert res["computed"] == 1 and done_cases(str(store)) == ids
 
 
+def test_the_cases_warnings_come_back_to_the_cli_once_each(tmp_path, capfd):
+    """A warning raised in a worker's case is said by the client, once per distinct message, as
+    the CLI's one line with how often the cases raised it; no worker prints its own (a raw
+    Python warning line with a source location). Here h = 20 s is beyond half each mass's
+    shortest period, which differs by case: three messages."""
+    f = tmp_path / "grid.toml"
+    f.write_text(SWEEP_TOML.format(t_end=100.0, h=20.0).replace(
+        '"control.kp_translational[0]" = [2e5, 4e5, 8e5]\n', ""))
+    assert main(["sweep", str(f), "--out", str(tmp_path / "s"), "--workers", "2", "--no-progress"]) == 0
+    err = capfd.readouterr().err.splitlines()
+    said = [e for e in err if e.startswith("phsplit: warning: sweep (1 time in 3 cases): h = 20 s is more than half")]
+    assert len(said) == 3 and len(set(said)) == 3, err
+    assert not any("Warning:" in e or ".py:" in e for e in err), err
+
+
 def test_a_sweep_file_with_a_value_the_vessel_refuses_starts_nothing(tmp_path, capsys):
     """Each value of a sweep file is tried on the vessel before anything is written or started
     (a case refused only by its combination of values is stored as invalid, as simulate_many

@@ -43,6 +43,8 @@ import numpy as np
 
 from . import _core, cf
 from . import scenario as scn
+from .cluster import (CONNECT_TIMEOUT, MAX_WORKERS, check_cluster,  # noqa: F401 - part of this module's API
+                      collecting_warnings, say_warnings)
 from .settings import Settings, settings_to_toml
 from .sweepstore import (_coord_name, _stackable, _summary_row, _write_batch, _write_case,
                          done_cases, remove_temporaries, store_index, write_summary, write_sweep_file)
@@ -505,67 +507,6 @@ def _run_cases(base_tables: dict, settings: Settings, cases: list[dict], store: 
     return results
 
 
-#: Most worker processes of a local cluster.
-MAX_WORKERS = 512
-
-#: Seconds to wait for a scheduler given by address to accept a connection.
-CONNECT_TIMEOUT = 3.0
-
-
-def check_cluster(scheduler: str | None = None, n_workers: int | None = None) -> None:
-    """Refuse cluster arguments that cannot work, before anything is written or started: a
-    worker count that is not an integer from 1 to :data:`MAX_WORKERS`, a worker count with a
-    scheduler (whose workers are its own), and a scheduler address that is malformed or where
-    nothing accepts a connection within :data:`CONNECT_TIMEOUT` seconds."""
-    import socket
-    from urllib.parse import urlsplit
-
-    if n_workers is not None:
-        if isinstance(n_workers, bool) or not isinstance(n_workers, (int, np.integer)) or not (
-                1 <= n_workers <= MAX_WORKERS):
-            raise _core.InvalidInputError(f"workers must be an integer from 1 to {MAX_WORKERS} (processes of the "
-                                          f"local cluster), got {n_workers!r}")
-        if scheduler is not None:
-            raise _core.InvalidInputError("give workers (a local cluster) or a scheduler (an existing cluster, "
-                                          "with its own workers), not both")
-    if scheduler is None:
-        return
-    if not isinstance(scheduler, str) or not scheduler.strip():
-        raise _core.InvalidInputError(f"scheduler must be an address like tcp://host:8786, got {scheduler!r}")
-    addr = scheduler if "://" in scheduler else "tcp://" + scheduler
-    if addr.startswith("inproc://"):
-        return  # a scheduler in this process (a LocalCluster with processes=False): the client finds it or fails at once
-    try:
-        u = urlsplit(addr)
-        host, port = u.hostname, u.port
-    except ValueError:
-        host = port = None
-    if u.scheme not in ("tcp", "tls", "ws", "wss") or not host or port is None or u.path not in ("", "/"):
-        raise _core.InvalidInputError(f"scheduler must be an address like tcp://host:8786 (tcp, tls, ws or wss, a host "
-                                      f"and a port), got {scheduler!r}")
-    deadline = time.monotonic() + CONNECT_TIMEOUT
-    try:
-        with socket.create_connection((host, port), timeout=CONNECT_TIMEOUT) as sock:
-            if u.scheme == "tcp":
-                # A Dask server greets a new connection with its handshake: a frame whose 8-byte
-                # little-endian length is small. Anything else does not speak Dask's protocol.
-                head = b""
-                while len(head) < 8:
-                    sock.settimeout(max(0.05, deadline - time.monotonic()))
-                    part = sock.recv(8 - len(head))
-                    if not part:
-                        break
-                    head += part
-                if len(head) < 8 or not 0 < int.from_bytes(head, "little") < 2**20:
-                    raise _core.InvalidInputError(
-                        f"the address {scheduler!r} answers, but not as a dask scheduler (its greeting is not "
-                        "Dask's); give the address the scheduler prints (e.g. tcp://host:8786)")
-    except OSError as e:
-        why = "no answer" if isinstance(e, TimeoutError) else (e.strerror or str(e))
-        raise _core.InvalidInputError(f"cannot reach the scheduler {scheduler!r}: {why} within "
-                                      f"{CONNECT_TIMEOUT:g} s (is a dask scheduler running there?)") from None
-
-
 @checked
 def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers: int | None = None,
               progress: bool = True, retries: int = 3) -> dict[str, Any]:
@@ -608,6 +549,7 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
             client.close()
         raise
     rows: dict[str, dict] = {}  # the summary rows of the cases computed now
+    said: dict[tuple[type, str], int] = {}  # the cases' warnings, said once each at the end
     lost: list[str] = []  # cases whose task failed outside the case: not stored
     t0 = time.perf_counter()
     if todo:
@@ -625,7 +567,8 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                 workers = max(1, len(client.scheduler_info().get("workers", {})))
             k = _batch_size(len(todo), workers, _saved_rows(sweep.settings))
             tasks = [todo[j:j + k] for j in range(0, len(todo), k)]
-            futures = {client.submit(_run_cases, base_tables, sweep.settings, [sweep.cases[i] for i in task], at,
+            futures = {client.submit(collecting_warnings, _run_cases, base_tables, sweep.settings,
+                                     [sweep.cases[i] for i in task], at,
                                      [ids[i] for i in task], key=ids[task[0]], retries=retries, pure=False): task
                        for task in tasks}
             with tqdm(total=len(ids), initial=len(ids) - len(todo), unit="case", disable=not progress) as bar:
@@ -633,7 +576,9 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                     task = futures[fut]
                     cids = [ids[i] for i in task]
                     try:
-                        results = fut.result()
+                        results, caught = fut.result()
+                        for w in caught:
+                            said[w] = said.get(w, 0) + 1
                     except Exception as e:  # noqa: BLE001 - a task's failure is reported, not fatal
                         # Not the cases' own outcome (that comes back as a result): listed in the
                         # summary, not stored, so that the next run computes them.
@@ -660,6 +605,7 @@ def run_sweep(sweep: Sweep, store: str, scheduler: str | None = None, n_workers:
                 remove_temporaries(store)  # a worker killed while writing a case leaves its temporary file
     elapsed = time.perf_counter() - t0
     summary = write_summary(store, ids, rows)
+    say_warnings(said, len(todo))
     return {"cases": len(ids), "computed": len(todo) - len(lost), "reused": len(ids) - len(todo), "lost": len(lost),
             "seconds": elapsed, "summary": summary}
 
