@@ -413,6 +413,10 @@ impl Force for Waves {
     fn forced(&self) -> bool {
         true
     }
+    /// Its part in flow S2 is empty.
+    fn assembly_reads_motion(&self) -> bool {
+        false
+    }
     /// With the phases at the reference point, the loads depend on time and heading only.
     fn forcing_uses_state(&self) -> bool {
         self.at_vessel
