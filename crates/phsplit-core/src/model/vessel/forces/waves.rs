@@ -366,14 +366,21 @@ impl Waves {
                 self.components[lo].direction - psi,
             );
             let (c, sg) = (&cs[lo..hi], &sn[lo..hi]);
+            // The six rows of each node in one pass over the components.
+            let acc: [[f64; 6]; 2] = [i0, i1].map(|i| {
+                dot2_rows(
+                    std::array::from_fn(|n| {
+                        (
+                            row(&self.by_node, 12 * i + n, lo, hi),
+                            row(&self.by_node, 12 * i + 6 + n, lo, hi),
+                        )
+                    }),
+                    c,
+                    sg,
+                )
+            });
             for n in 0..6 {
-                let mut acc = [0.0; 2];
-                for (j, i) in [i0, i1].into_iter().enumerate() {
-                    let re = row(&self.by_node, 12 * i + n, lo, hi);
-                    let im = row(&self.by_node, 12 * i + 6 + n, lo, hi);
-                    acc[j] = dot2(re, c, im, sg);
-                }
-                first[n] += (1.0 - wd) * acc[0] + wd * acc[1];
+                first[n] += (1.0 - wd) * acc[0][n] + wd * acc[1][n];
             }
             if self.drift.is_some() {
                 let a = &self.components[lo..hi];
@@ -462,22 +469,29 @@ impl Force for Waves {
     }
 }
 
-/// `Σ_k (a_k b_k − c_k d_k)`, in two interleaved partial sums.
+/// `Σ_k (a_k c_k − b_k s_k)` for each of the rows `(a, b)`, in two interleaved partial sums per
+/// row (even and odd `k`, the last odd one in the even sum), by pairs of `k` (the pairs of
+/// fixed size let the compiler use two-lane arithmetic).
 #[inline]
-fn dot2(a: &[f64], b: &[f64], c: &[f64], d: &[f64]) -> f64 {
-    let n = a.len().min(b.len()).min(c.len()).min(d.len());
-    let (a, b, c, d) = (&a[..n], &b[..n], &c[..n], &d[..n]);
-    let mut acc = [0.0; 2];
-    let mut i = 0;
-    while i + 1 < n {
-        acc[0] += a[i] * b[i] - c[i] * d[i];
-        acc[1] += a[i + 1] * b[i + 1] - c[i + 1] * d[i + 1];
-        i += 2;
-    }
-    if i < n {
-        acc[0] += a[i] * b[i] - c[i] * d[i];
-    }
-    acc[0] + acc[1]
+fn dot2_rows<const R: usize>(rows: [(&[f64], &[f64]); R], c: &[f64], s: &[f64]) -> [f64; R] {
+    rows.map(|(a, b)| {
+        let n = a.len().min(b.len()).min(c.len()).min(s.len());
+        let (a, b, c, s) = (&a[..n], &b[..n], &c[..n], &s[..n]);
+        let mut acc = [0.0; 2];
+        let pairs = a
+            .chunks_exact(2)
+            .zip(b.chunks_exact(2))
+            .zip(c.chunks_exact(2).zip(s.chunks_exact(2)));
+        for ((a, b), (c, s)) in pairs {
+            acc[0] += a[0] * c[0] - b[0] * s[0];
+            acc[1] += a[1] * c[1] - b[1] * s[1];
+        }
+        if n % 2 == 1 {
+            let i = n - 1;
+            acc[0] += a[i] * c[i] - b[i] * s[i];
+        }
+        acc[0] + acc[1]
+    })
 }
 
 #[cfg(test)]
