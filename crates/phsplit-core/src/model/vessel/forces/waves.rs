@@ -94,8 +94,9 @@ pub struct Waves {
     by_pair: Vec<[f64; 24]>,
     /// Each run's first pair.
     pair_start: Vec<usize>,
-    /// At direction node `i`, `D_i(ω_k)` (3 rows over the components): `[(3 i + n) K + k]`.
-    drift_by_node: Vec<f64>,
+    /// At direction node `i`, `D_i(ω_k)` (its three entries, and a zero) of component `k`:
+    /// `[i K + k]`.
+    drift_by_node: Vec<[f64; 4]>,
 }
 
 fn list(p: &mut Params, key: &str, unit: &str, range: Range) -> crate::Result<Vec<f64>> {
@@ -250,12 +251,12 @@ impl Waves {
                 }
             }
         }
-        let mut drift_by_node = vec![0.0; if drift.is_some() { nd * 3 * k } else { 0 }];
+        let mut drift_by_node = vec![[0.0; 4]; if drift.is_some() { nd * k } else { 0 }];
         if drift.is_some() {
             for c in 0..k {
                 for i in 0..nd {
                     for n in 0..3 {
-                        drift_by_node[(3 * i + n) * k + c] = pre_drift[c].re[i][n];
+                        drift_by_node[i * k + c][n] = pre_drift[c].re[i][n];
                     }
                 }
             }
@@ -362,8 +363,8 @@ impl Waves {
     /// w Σ_k a_k Re(F_1k e^{iθ_k})`), each sum over contiguous rows.
     /// `[tre, tim]`: the time factors; `[sre, sim]`: the space factors; `[cs, sn]`: buffers for
     /// their products.
-    fn sum<'a>(
-        &'a self,
+    fn sum(
+        &self,
         psi: f64,
         [tre, tim]: [&[f64]; 2],
         [sre, sim]: [&[f64]; 2],
@@ -378,9 +379,6 @@ impl Waves {
         let mut first = [0.0; 6];
         let mut s = [0.0; 3];
         let mut mean = [0.0; 3];
-        let row = |v: &'a [f64], r: usize, lo: usize, hi: usize| -> &'a [f64] {
-            &v[r * k + lo..r * k + hi]
-        };
         let pairs = self.by_pair.len() / self.force_rao.directions.len().max(1);
         for (&(lo, hi), &start) in self.groups.iter().zip(&self.pair_start) {
             let (i0, i1, wd) = periodic_weights(
@@ -398,17 +396,21 @@ impl Waves {
             }
             if self.drift.is_some() {
                 let a = &self.components[lo..hi];
-                for n in 0..3 {
-                    let d0 = row(&self.drift_by_node, 3 * i0 + n, lo, hi);
-                    let d1 = row(&self.drift_by_node, 3 * i1 + n, lo, hi);
-                    let (mut sm, mut mm) = (0.0, 0.0);
-                    for q in 0..hi - lo {
-                        let dv = (1.0 - wd) * d0[q] + wd * d1[q];
-                        sm += a[q].amplitude * dv.abs().sqrt() * c[q];
-                        mm += a[q].amplitude * a[q].amplitude * dv;
+                let d0 = &self.drift_by_node[i0 * k + lo..i0 * k + hi];
+                let d1 = &self.drift_by_node[i1 * k + lo..i1 * k + hi];
+                // Each entry's sums over the run in order, the three entries side by side.
+                let (mut sm, mut mm) = ([0.0; 4], [0.0; 4]);
+                for (((a, c), d0), d1) in a.iter().zip(c).zip(d0).zip(d1) {
+                    let a = a.amplitude;
+                    for n in 0..4 {
+                        let dv = (1.0 - wd) * d0[n] + wd * d1[n];
+                        sm[n] += a * dv.abs().sqrt() * c;
+                        mm[n] += a * a * dv;
                     }
-                    s[n] += sm;
-                    mean[n] += mm;
+                }
+                for n in 0..3 {
+                    s[n] += sm[n];
+                    mean[n] += mm[n];
                 }
             }
         }
