@@ -255,9 +255,8 @@ impl Waves {
         if drift.is_some() {
             for c in 0..k {
                 for i in 0..nd {
-                    for n in 0..3 {
-                        drift_by_node[i * k + c][n] = pre_drift[c].re[i][n];
-                    }
+                    let d = pre_drift[c].re[i];
+                    drift_by_node[i * k + c] = [d[0], d[1], d[2], 0.0];
                 }
             }
         }

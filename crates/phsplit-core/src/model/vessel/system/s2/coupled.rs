@@ -107,6 +107,8 @@ fn six_blocks(b: &S2Builder, sc: &Six, inv: &Six) -> (Structure<6>, Six) {
 /// whose reduced systems are the diagonal blocks of the `6 × 6` ones (the same numbers but for
 /// the sign of a zero: the coupled products and eliminations add only exact zeros to them), at a
 /// quarter of the factorisations' and products' cost and half the solves'.
+// Made once per sub-step and kept on its stack: no box for the larger variant.
+#[allow(clippy::large_enum_variant)]
 enum SixSolver {
     Coupled(StageSolver<6>),
     Apart([StageSolver<3>; 2]),
