@@ -11,6 +11,9 @@
 //! - the row `e^{i ω mδ}` from a table of `M` rows built once with the component;
 //! - `e^{i ω r}`, `|ω r| ≤ 1/4`, by its Taylor polynomials to degree 12 (cosine) and 13 (sine),
 //!   whose first omitted terms are below `4·10⁻²⁰`.
+//!   They depend on `r` alone, and a step commensurate with `δ` meets a few offsets `r` over
+//!   and over (with `h = 0.5 s`, the midpoint rule's stage times are multiples of `1/8 s`): the
+//!   per-thread memo keeps the last few sets as computed.
 //!
 //! Because `Δ` and `δ` are powers of two, `jΔ`, `t − jΔ`, `mδ` and `r` are exact in floating
 //! point, every factor is a function of `t` alone computed the same way whatever was evaluated
@@ -33,7 +36,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 const ROWS: usize = 64;
 /// The bound on `|ω r|` that the Taylor polynomials are accurate to round-off on.
 const REDUCED: f64 = 0.25;
-/// Anchors a thread keeps (a few seas evaluated in turn, each at a few times).
+/// Anchors, and remainders, a thread keeps (a few seas evaluated in turn, each at a few times).
 const MEMO: usize = 8;
 
 /// An identity for the per-thread memo of anchors: unique per set of components (copies share
@@ -73,10 +76,36 @@ struct Anchor {
     im: Vec<f64>,
 }
 
+/// The remainder factors `e^{i ω_k r}` of one set of components at one offset `r` (its bits).
+struct Remainder {
+    key: u64,
+    r: u64,
+    re: Vec<f64>,
+    im: Vec<f64>,
+}
+
+/// A thread's memo: recently used anchors and remainders, each the oldest replaced first, and
+/// the result buffers.
+struct Memo {
+    anchors: Vec<Anchor>,
+    next: usize,
+    rems: Vec<Remainder>,
+    next_rem: usize,
+    re: Vec<f64>,
+    im: Vec<f64>,
+}
+
 thread_local! {
-    /// Recently used anchors, the oldest replaced first, and the result buffers.
-    static MEMO_ANCHORS: RefCell<(Vec<Anchor>, usize, Vec<f64>, Vec<f64>)> =
-        const { RefCell::new((Vec::new(), 0, Vec::new(), Vec::new())) };
+    static MEMO_ANCHORS: RefCell<Memo> = const {
+        RefCell::new(Memo {
+            anchors: Vec::new(),
+            next: 0,
+            rems: Vec::new(),
+            next_rem: 0,
+            re: Vec::new(),
+            im: Vec::new(),
+        })
+    };
 }
 
 impl Phasors {
@@ -149,7 +178,14 @@ impl Phasors {
         let r = r - m as f64 * self.delta;
         MEMO_ANCHORS.with(|cell| {
             let mut memo = cell.borrow_mut();
-            let (anchors, next, re, im) = &mut *memo;
+            let Memo {
+                anchors,
+                next,
+                rems,
+                next_rem,
+                re,
+                im,
+            } = &mut *memo;
             let a = match anchors.iter().position(|a| a.key == self.key.0 && a.j == j) {
                 Some(i) => i,
                 None => {
@@ -167,29 +203,41 @@ impl Phasors {
                         re: are,
                         im: aim,
                     };
-                    if anchors.len() < MEMO {
-                        anchors.push(new);
-                        anchors.len() - 1
-                    } else {
-                        let i = *next;
-                        anchors[i] = new;
-                        *next = (i + 1) % MEMO;
-                        i
+                    keep(anchors, next, new)
+                }
+            };
+            // The remainder factors depend on `r` alone: a step size commensurate with `δ`
+            // (h = 0.5 s, 0.25 s, 1 s, … and the midpoint rule's nodes) meets a few offsets
+            // again and again, which are kept as computed.
+            let rb = r.to_bits();
+            let q = match rems.iter().position(|e| e.key == self.key.0 && e.r == rb) {
+                Some(i) => i,
+                None => {
+                    let (mut rre, mut rim) = (vec![0.0; k], vec![0.0; k]);
+                    for i in 0..k {
+                        (rre[i], rim[i]) = taylor(self.omega[i] * r);
                     }
+                    let new = Remainder {
+                        key: self.key.0,
+                        r: rb,
+                        re: rre,
+                        im: rim,
+                    };
+                    keep(rems, next_rem, new)
                 }
             };
             re.resize(k, 0.0);
             im.resize(k, 0.0);
             let an = &anchors[a];
             let (ar, ai) = (&an.re[..k], &an.im[..k]);
+            let (cr, ci) = (&rems[q].re[..k], &rems[q].im[..k]);
             let (tr, ti) = (
                 &self.row_re[m * k..(m + 1) * k],
                 &self.row_im[m * k..(m + 1) * k],
             );
-            let w = &self.omega[..k];
             let (re, im) = (&mut re[..k], &mut im[..k]);
             for i in 0..k {
-                let (c, s) = taylor(w[i] * r);
+                let (c, s) = (cr[i], ci[i]);
                 // anchor · row · e^{iωr}
                 let pr = ar[i] * tr[i] - ai[i] * ti[i];
                 let pi = ar[i] * ti[i] + ai[i] * tr[i];
@@ -198,6 +246,20 @@ impl Phasors {
             }
             f(re, im)
         })
+    }
+}
+
+/// Put `new` in a memo of at most [`MEMO`] entries (replacing the oldest when full, `next` its
+/// index) and return where.
+fn keep<T>(entries: &mut Vec<T>, next: &mut usize, new: T) -> usize {
+    if entries.len() < MEMO {
+        entries.push(new);
+        entries.len() - 1
+    } else {
+        let i = *next;
+        entries[i] = new;
+        *next = (i + 1) % MEMO;
+        i
     }
 }
 
@@ -255,6 +317,12 @@ pub(crate) mod tests {
         // Stage times of an hour and beyond, Gauss nodes included, in a random order, and the
         // same times again after others (the memo must not change a result).
         let mut times: Vec<f64> = (0..3000).map(|_| 7200.0 * uniform(&mut st)).collect();
+        // The stage times of the midpoint rule with h = 0.5 s and of two-stage Gauss, which
+        // meet a few offsets again and again (the memo of remainders).
+        for n in 0..400 {
+            let t0 = 0.25 * n as f64;
+            times.extend([t0 + 0.125, t0 + 0.25 * (0.5 - 3f64.sqrt() / 6.0)]);
+        }
         times.extend([
             0.0,
             3600.0,

@@ -97,6 +97,10 @@ pub struct VesselSystem<'a> {
     forced_stateful: bool,
     /// Whether a component's forcing depends on time only (evaluated once per stage).
     forced_timed: bool,
+    /// Whether a component's part in flow S2 reads the frozen view's velocities or the
+    /// actuators' memory ([`Force::assembly_reads_motion`]): the kept assembly then keys on
+    /// them too (`system/memo.rs`).
+    assembly_reads_motion: bool,
     /// Why a sub-flow gave up (a [`GaveUp`] code; 0: none), for the run's failure message.
     gave_up: std::sync::Arc<std::sync::atomic::AtomicU8>,
     /// How many rate-limited thrusters the state remembers ([`VesselState::act`]).
@@ -172,6 +176,7 @@ impl<'a> VesselSystem<'a> {
                 .forces
                 .iter()
                 .any(|f| f.forced() && !f.forcing_uses_state()),
+            assembly_reads_motion: vessel.forces.iter().any(|f| f.assembly_reads_motion()),
             gave_up: Default::default(),
             actuators: vessel.actuators(),
             own_dim: vessel.own_dim(),

@@ -292,6 +292,10 @@ impl Force for Current {
     fn forcing_uses_state(&self) -> bool {
         self.quadratic.is_some()
     }
+    /// Only the quadratic part's linearisation reads the velocities.
+    fn assembly_reads_motion(&self) -> bool {
+        self.quadratic.is_some()
+    }
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
         let vc = fr.qt * self.velocity_at(t);
         if self.table.is_some() {

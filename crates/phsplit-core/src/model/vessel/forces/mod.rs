@@ -388,6 +388,14 @@ pub trait Force: Debug + Send + Sync {
     fn forced(&self) -> bool {
         false
     }
+    /// Whether its part in flow S2 ([`Force::add_s2`]) reads the frozen view's velocities or
+    /// the actuators' memory ([`Frozen::velocity`], [`Frozen::actuators`]), so that an assembly
+    /// of S2 kept for reuse must match the momenta and that memory too (`system/memo.rs`). By
+    /// default, whether it has a forcing part (a component that linearises its forcing at the
+    /// sub-step's start does); a forcing that keeps nothing in the assembly says no.
+    fn assembly_reads_motion(&self) -> bool {
+        self.forced()
+    }
     /// Whether its forcing depends on the block states (else only on time and the frozen
     /// attitude: the collocation then evaluates it once per stage, not once per iteration).
     fn forcing_uses_state(&self) -> bool {

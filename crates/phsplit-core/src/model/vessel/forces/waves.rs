@@ -87,11 +87,16 @@ pub struct Waves {
     /// The runs `lo..hi` of consecutive components that travel the same way (one run for a
     /// long-crested sea): they share the interpolation weights in direction.
     groups: Vec<(usize, usize)>,
-    /// At direction node `i`, `a_k Re F_i(ω_k)` (6 rows) and `a_k Im F_i(ω_k)` (6 rows), each
-    /// row over the components: `[(12 i + q) K + k]`.
-    by_node: Vec<f64>,
-    /// At direction node `i`, `D_i(ω_k)` (3 rows over the components): `[(3 i + n) K + k]`.
-    drift_by_node: Vec<f64>,
+    /// At direction node `i`, `a_k Re F_i(ω_k)` and `a_k Im F_i(ω_k)` (6 rows each) by pairs
+    /// of consecutive components of a run (the last of a run of odd length alone, beside
+    /// zeros): the pair `p` of node `i` at `[i P + p]` (`P` pairs in all), the six real parts of
+    /// the first at `0..6` and its imaginary parts at `6..12`, the second's at `12..24`.
+    by_pair: Vec<[f64; 24]>,
+    /// Each run's first pair.
+    pair_start: Vec<usize>,
+    /// At direction node `i`, `D_i(ω_k)` (its three entries, and a zero) of component `k`:
+    /// `[i K + k]`.
+    drift_by_node: Vec<[f64; 4]>,
 }
 
 fn list(p: &mut Params, key: &str, unit: &str, range: Range) -> crate::Result<Vec<f64>> {
@@ -195,8 +200,9 @@ thread_local! {
     /// The spatial factors `e^{−iκ_k (x cos β_k + y sin β_k)}` at the reference point of the
     /// last sea evaluated on this thread: `(sea, x, y)` (the sea by its time factors' identity,
     /// the point by its bits) and the factors.
-    static AT_POINT: RefCell<(u64, u64, u64, Vec<f64>, Vec<f64>)> =
-        const { RefCell::new((0, 0, 0, Vec::new(), Vec::new())) };
+    #[allow(clippy::type_complexity)]
+    static AT_POINT: RefCell<(u64, u64, u64, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> =
+        const { RefCell::new((0, 0, 0, Vec::new(), Vec::new(), Vec::new(), Vec::new())) };
 }
 
 impl Waves {
@@ -226,24 +232,38 @@ impl Waves {
             }
         }
         let nd = force_rao.directions.len();
-        let mut by_node = vec![0.0; nd * 12 * k];
-        let mut drift_by_node = vec![0.0; if drift.is_some() { nd * 3 * k } else { 0 }];
-        for (c, comp) in components.iter().enumerate() {
-            for i in 0..nd {
-                for n in 0..6 {
-                    by_node[(12 * i + n) * k + c] = comp.amplitude * pre_rao[c].re[i][n];
-                    by_node[(12 * i + 6 + n) * k + c] = comp.amplitude * pre_rao[c].im[i][n];
-                }
-                if drift.is_some() {
-                    for n in 0..3 {
-                        drift_by_node[(3 * i + n) * k + c] = pre_drift[c].re[i][n];
+        let mut pair_start = Vec::with_capacity(groups.len());
+        let mut pairs = 0;
+        for &(lo, hi) in &groups {
+            pair_start.push(pairs);
+            pairs += (hi - lo).div_ceil(2);
+        }
+        let mut by_pair = vec![[0.0; 24]; nd * pairs];
+        for (&(lo, hi), &start) in groups.iter().zip(&pair_start) {
+            for c in lo..hi {
+                let (p, lane) = (start + (c - lo) / 2, (c - lo) % 2);
+                for i in 0..nd {
+                    let blk = &mut by_pair[i * pairs + p];
+                    for n in 0..6 {
+                        blk[12 * lane + n] = components[c].amplitude * pre_rao[c].re[i][n];
+                        blk[12 * lane + 6 + n] = components[c].amplitude * pre_rao[c].im[i][n];
                     }
+                }
+            }
+        }
+        let mut drift_by_node = vec![[0.0; 4]; if drift.is_some() { nd * k } else { 0 }];
+        if drift.is_some() {
+            for c in 0..k {
+                for i in 0..nd {
+                    let d = pre_drift[c].re[i];
+                    drift_by_node[i * k + c] = [d[0], d[1], d[2], 0.0];
                 }
             }
         }
         Waves {
             groups,
-            by_node,
+            by_pair,
+            pair_start,
             drift_by_node,
             components,
             pre_rao,
@@ -319,7 +339,7 @@ impl Waves {
     ) -> (Vector6<f64>, Vector3<f64>) {
         AT_POINT.with(|cell| {
             let mut at = cell.borrow_mut();
-            let (sea, px, py, sre, sim) = &mut *at;
+            let (sea, px, py, sre, sim, cs, sn) = &mut *at;
             let key = self.time.key();
             if !fixed || *sea != key || *px != x.to_bits() || *py != y.to_bits() {
                 self.spatial(x, y, sre, sim);
@@ -329,8 +349,9 @@ impl Waves {
                     (0, 0, 0)
                 };
             }
-            self.time
-                .with_at(t, |tre, tim| self.sum(psi, tre, tim, sre, sim))
+            self.time.with_at(t, |tre, tim| {
+                self.sum(psi, [tre, tim], [sre, sim], [cs, sn])
+            })
         })
     }
 
@@ -339,55 +360,56 @@ impl Waves {
     /// a direction, the linear interpolation in direction taken out of each run's sums
     /// (`Σ_k a_k Re(((1 − w) F_0k + w F_1k) e^{iθ_k}) = (1 − w) Σ_k a_k Re(F_0k e^{iθ_k}) +
     /// w Σ_k a_k Re(F_1k e^{iθ_k})`), each sum over contiguous rows.
-    fn sum<'a>(
-        &'a self,
+    /// `[tre, tim]`: the time factors; `[sre, sim]`: the space factors; `[cs, sn]`: buffers for
+    /// their products.
+    fn sum(
+        &self,
         psi: f64,
-        tre: &[f64],
-        tim: &[f64],
-        sre: &[f64],
-        sim: &[f64],
+        [tre, tim]: [&[f64]; 2],
+        [sre, sim]: [&[f64]; 2],
+        [cs, sn]: [&mut Vec<f64>; 2],
     ) -> (Vector6<f64>, Vector3<f64>) {
         let k = self.components.len();
-        let mut cs = vec![0.0; k];
-        let mut sn = vec![0.0; k];
-        for i in 0..k {
-            cs[i] = tre[i] * sre[i] - tim[i] * sim[i];
-            sn[i] = tre[i] * sim[i] + tim[i] * sre[i];
-        }
+        cs.clear();
+        sn.clear();
+        cs.extend((0..k).map(|i| tre[i] * sre[i] - tim[i] * sim[i]));
+        sn.extend((0..k).map(|i| tre[i] * sim[i] + tim[i] * sre[i]));
+        let (cs, sn) = (&cs[..], &sn[..]);
         let mut first = [0.0; 6];
         let mut s = [0.0; 3];
         let mut mean = [0.0; 3];
-        let row = |v: &'a [f64], r: usize, lo: usize, hi: usize| -> &'a [f64] {
-            &v[r * k + lo..r * k + hi]
-        };
-        for &(lo, hi) in &self.groups {
+        let pairs = self.by_pair.len() / self.force_rao.directions.len().max(1);
+        for (&(lo, hi), &start) in self.groups.iter().zip(&self.pair_start) {
             let (i0, i1, wd) = periodic_weights(
                 &self.force_rao.directions,
                 self.components[lo].direction - psi,
             );
             let (c, sg) = (&cs[lo..hi], &sn[lo..hi]);
+            // The six rows of each node in one pass over the run's pairs of components.
+            let acc = [i0, i1].map(|i| {
+                let at = i * pairs + start;
+                first_order(&self.by_pair[at..at + (hi - lo).div_ceil(2)], c, sg)
+            });
             for n in 0..6 {
-                let mut acc = [0.0; 2];
-                for (j, i) in [i0, i1].into_iter().enumerate() {
-                    let re = row(&self.by_node, 12 * i + n, lo, hi);
-                    let im = row(&self.by_node, 12 * i + 6 + n, lo, hi);
-                    acc[j] = dot2(re, c, im, sg);
-                }
-                first[n] += (1.0 - wd) * acc[0] + wd * acc[1];
+                first[n] += (1.0 - wd) * acc[0][n] + wd * acc[1][n];
             }
             if self.drift.is_some() {
                 let a = &self.components[lo..hi];
-                for n in 0..3 {
-                    let d0 = row(&self.drift_by_node, 3 * i0 + n, lo, hi);
-                    let d1 = row(&self.drift_by_node, 3 * i1 + n, lo, hi);
-                    let (mut sm, mut mm) = (0.0, 0.0);
-                    for q in 0..hi - lo {
-                        let dv = (1.0 - wd) * d0[q] + wd * d1[q];
-                        sm += a[q].amplitude * dv.abs().sqrt() * c[q];
-                        mm += a[q].amplitude * a[q].amplitude * dv;
+                let d0 = &self.drift_by_node[i0 * k + lo..i0 * k + hi];
+                let d1 = &self.drift_by_node[i1 * k + lo..i1 * k + hi];
+                // Each entry's sums over the run in order, the three entries side by side.
+                let (mut sm, mut mm) = ([0.0; 4], [0.0; 4]);
+                for (((a, c), d0), d1) in a.iter().zip(c).zip(d0).zip(d1) {
+                    let a = a.amplitude;
+                    for n in 0..4 {
+                        let dv = (1.0 - wd) * d0[n] + wd * d1[n];
+                        sm[n] += a * dv.abs().sqrt() * c;
+                        mm[n] += a * a * dv;
                     }
-                    s[n] += sm;
-                    mean[n] += mm;
+                }
+                for n in 0..3 {
+                    s[n] += sm[n];
+                    mean[n] += mm[n];
                 }
             }
         }
@@ -412,6 +434,10 @@ impl Force for Waves {
     fn add_s2(&self, _fr: &Frozen, _b: &mut S2Builder) {}
     fn forced(&self) -> bool {
         true
+    }
+    /// Its part in flow S2 is empty.
+    fn assembly_reads_motion(&self) -> bool {
+        false
     }
     /// With the phases at the reference point, the loads depend on time and heading only.
     fn forcing_uses_state(&self) -> bool {
@@ -458,22 +484,31 @@ impl Force for Waves {
     }
 }
 
-/// `Σ_k (a_k b_k − c_k d_k)`, in two interleaved partial sums.
+/// `Σ_k (a_nk c_k − b_nk s_k)` for the six rows `n` of a run's pairs of components `blocks`
+/// ([`Waves`]' `by_pair`, with `a` the real and `b` the imaginary parts), in two interleaved
+/// partial sums per row (even and odd `k`, the last of an odd run in the even sum): the pairs'
+/// fixed layout lets the compiler use two-lane arithmetic.
 #[inline]
-fn dot2(a: &[f64], b: &[f64], c: &[f64], d: &[f64]) -> f64 {
-    let n = a.len().min(b.len()).min(c.len()).min(d.len());
-    let (a, b, c, d) = (&a[..n], &b[..n], &c[..n], &d[..n]);
-    let mut acc = [0.0; 2];
-    let mut i = 0;
-    while i + 1 < n {
-        acc[0] += a[i] * b[i] - c[i] * d[i];
-        acc[1] += a[i + 1] * b[i + 1] - c[i + 1] * d[i + 1];
-        i += 2;
+fn first_order(blocks: &[[f64; 24]], c: &[f64], s: &[f64]) -> [f64; 6] {
+    let n = c.len().min(s.len()).min(2 * blocks.len());
+    let mut acc = [[0.0; 6]; 2];
+    for (blk, (c, s)) in blocks
+        .iter()
+        .zip(c[..n].chunks_exact(2).zip(s[..n].chunks_exact(2)))
+    {
+        for l in 0..2 {
+            for r in 0..6 {
+                acc[l][r] += blk[12 * l + r] * c[l] - blk[12 * l + 6 + r] * s[l];
+            }
+        }
     }
-    if i < n {
-        acc[0] += a[i] * b[i] - c[i] * d[i];
+    if n % 2 == 1 {
+        let (blk, q) = (&blocks[n / 2], n - 1);
+        for r in 0..6 {
+            acc[0][r] += blk[r] * c[q] - blk[6 + r] * s[q];
+        }
     }
-    acc[0] + acc[1]
+    std::array::from_fn(|r| acc[0][r] + acc[1][r])
 }
 
 #[cfg(test)]

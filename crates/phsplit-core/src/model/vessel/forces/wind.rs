@@ -56,6 +56,8 @@ pub struct Wind {
     pub coefficients: Vec<[f64; 3]>,
     /// The gusts' time factors `e^{i(ω_k t + φ_k)}`, fast (`crate::model::phasors`).
     time: Phasors,
+    /// `(cos, sin)` of `direction`, once (the loads take them at every pass of the fixed point).
+    towards: (f64, f64),
 }
 
 fn list(
@@ -125,6 +127,7 @@ pub fn build(p: &mut Params, _body: &super::Body) -> crate::Result<Option<Arc<dy
     Ok(Some(Arc::new(Wind {
         speed,
         direction,
+        towards: (direction.cos(), direction.sin()),
         time: Phasors::new(gf.clone(), gp.clone()),
         gusts: (0..gf.len()).map(|k| (gf[k], ga[k], gp[k])).collect(),
         frontal_area,
@@ -203,7 +206,8 @@ impl Wind {
         v: &Vector3<f64>,
         u: f64,
     ) -> (Vector3<f64>, Vector3<f64>) {
-        let wind = Vector3::new(u * self.direction.cos(), u * self.direction.sin(), 0.0);
+        let (c, s) = self.towards;
+        let wind = Vector3::new(u * c, u * s, 0.0);
         let rel = qt * wind - v;
         let vr2 = rel.x * rel.x + rel.y * rel.y;
         if vr2 == 0.0 {
@@ -233,6 +237,10 @@ impl Force for Wind {
     fn add_s2(&self, _fr: &Frozen, _b: &mut S2Builder) {}
     fn forced(&self) -> bool {
         true
+    }
+    /// Its part in flow S2 is empty.
+    fn assembly_reads_motion(&self) -> bool {
+        false
     }
     fn add_forcing(&self, fr: &Frozen, t: f64, z: &[Z3; 2], g: &mut Forcing) {
         let (f, m) = self.loads_at_speed(&fr.qt, &fr.nu(z)[0], self.speed_fast(t));
@@ -268,6 +276,7 @@ mod tests {
         let w = Wind {
             speed: 15.0,
             direction: 0.3,
+            towards: (0.3f64.cos(), 0.3f64.sin()),
             time: Phasors::new(
                 gusts.iter().map(|g| g.0).collect(),
                 gusts.iter().map(|g| g.2).collect(),
@@ -307,6 +316,7 @@ mod tests {
         let w = Wind {
             speed: 20.0,
             direction: std::f64::consts::PI, // blowing towards −x
+            towards: (-1.0, std::f64::consts::PI.sin()),
             gusts: vec![],
             time: Phasors::new(vec![], vec![]),
             frontal_area: 300.0,

@@ -2,11 +2,13 @@
 //!
 //! Flow S2's assembly (the frozen view's Euler angles, every component's rows, each account's
 //! booked rows) depends on the state only through the attitude `Q` and whether the controller
-//! acts, and, for a component with a forcing part, the velocities `ν₀` it linearises at and the
-//! actuators' memory ([`Frozen::velocity`], [`Frozen::actuators`]: only such components read
-//! them). The assembly is kept with the bits of what it was built from and reused when they
-//! match bit for bit (`Q`, the controller; and the momenta and the actuators' memory when a
-//! component has a forcing part), with the view's velocities and memory set to the new state's;
+//! acts, and, for a component with a forcing part that it linearises in the assembly, the
+//! velocities `ν₀` it linearises at and the actuators' memory ([`Frozen::velocity`],
+//! [`Frozen::actuators`]: only such components read them, as each says by
+//! [`assembly_reads_motion`](super::super::forces::Force::assembly_reads_motion)).
+//! The assembly is kept with the bits of what it was built from and reused when they match bit
+//! for bit (`Q`, the controller; and the momenta and the actuators' memory when a component's
+//! part reads them), with the view's velocities and memory set to the new state's;
 //! one made with the ledger's rows serves a sub-step without the ledger too. A run's numbers are
 //! the same as without it.
 //!
@@ -27,8 +29,8 @@ use super::VesselSystem;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 use std::sync::Mutex;
 
-/// What an assembly depends on, bit for bit: `Q`, the controller's state, and, where a component
-/// has a forcing part, the momenta `p`, `m` and the actuators' memory. An assembly with the
+/// What an assembly depends on, bit for bit: `Q`, the controller's state, and, where a
+/// component's part reads them ([`Force::assembly_reads_motion`](super::super::forces::Force::assembly_reads_motion)). the momenta `p`, `m` and the actuators' memory. An assembly with the
 /// ledger (each account's rows) serves a sub-step without it too.
 #[derive(Clone, Copy)]
 struct Key {
@@ -56,7 +58,8 @@ impl Key {
             act: s.act,
         }
     }
-    /// Whether an assembly at `s` would be this one's; `whole`: a component has a forcing part.
+    /// Whether an assembly at `s` would be this one's; `whole`: a component's part reads the
+    /// momenta or the actuators' memory.
     fn matches(&self, s: &VesselState, on: bool, whole: bool) -> bool {
         let (a, b) = (&self.act, &s.act);
         self.on == on
@@ -128,7 +131,10 @@ impl<'a> VesselSystem<'a> {
         };
         let kept = &mut *guard;
         let entry = match &mut kept.entry {
-            Some(e) if e.key.matches(s, on, self.forced) && (e.b.booked.is_some() || !ledger) => {
+            Some(e)
+                if e.key.matches(s, on, self.assembly_reads_motion)
+                    && (e.b.booked.is_some() || !ledger) =>
+            {
                 if e.by_probe && !by_probe {
                     e.reused = true;
                     self.s2_memo.1.store(true, Relaxed);
@@ -290,19 +296,21 @@ mod tests {
     }
 
     /// What lets the kept assembly leave the momenta and the actuators' memory out of its key
-    /// where no component has a forcing part: no component without one reads them. Each such
-    /// component of every preset, of the paper's vessel with an external load and a current,
-    /// and of the pipe-lay vessel gives the same rows at rest and with velocities and a memory.
+    /// where no component's part reads them ([`Force::assembly_reads_motion`](super::super::forces::Force::assembly_reads_motion)). each component
+    /// that says so (every one without a forcing part, and the wind), of every preset, of the
+    /// paper's vessel with an external load, a current and a gusting wind, and of the pipe-lay
+    /// vessel, gives the same rows at rest and with velocities and a memory.
     #[test]
-    fn components_without_a_forcing_part_read_neither_velocities_nor_memory() {
+    fn components_whose_assembly_reads_no_motion_read_neither_velocities_nor_memory() {
         let mut vessels: Vec<Vessel> = PRESETS
             .iter()
             .map(|p| Vessel::preset(p.0).unwrap())
             .collect();
         vessels.push(
             Vessel::from_toml_str(&format!(
-                "{}\n[external]\nforce = [2e5, -1e5, 3e4]\nmoment = [1e6, 0, -2e6]\npoint = [-40, 5, 3]\n[current]\nvelocity = [0.6, -0.8, 0.0]\n",
-                super::super::super::PAPER_VESSEL_TOML
+                "{}\n[external]\nforce = [2e5, -1e5, 3e4]\nmoment = [1e6, 0, -2e6]\npoint = [-40, 5, 3]\n[current]\nvelocity = [0.6, -0.8, 0.0]\n{}",
+                super::super::super::PAPER_VESSEL_TOML,
+                "[wind]\nspeed = 15.0\ndirection = 30.0\nfrontal_area = 182.0\nlateral_area = 533.0\nlength = 76.2\nair_density = 1.225\nangles = [0.0, 90.0, 180.0, 270.0]\ncx = [0.6, 0.0, -0.7, 0.0]\ncy = [0.0, 0.9, 0.0, -0.9]\ncn = [0.0, 0.05, 0.0, -0.05]\ngust_frequencies = [0.05, 0.2]\ngust_amplitudes = [1.0, 0.5]\ngust_phases = [0.3, 2.0]\n"
             ))
             .unwrap(),
         );
@@ -334,7 +342,7 @@ mod tests {
                 (b.sys, b.cross, b.booked)
             };
             for (f, &base) in v.forces.iter().zip(&sys.bases) {
-                if !f.forced() {
+                if !f.assembly_reads_motion() {
                     assert_eq!(
                         assemble(f.as_ref(), base, &rest),
                         assemble(f.as_ref(), base, &going),
@@ -345,6 +353,6 @@ mod tests {
                 }
             }
         }
-        assert!(checked >= 12, "{checked}");
+        assert!(checked >= 13, "{checked}");
     }
 }

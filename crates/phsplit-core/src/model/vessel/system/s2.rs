@@ -206,6 +206,14 @@ impl VesselSystem<'_> {
 /// as it was (`ω ≈ 1`). Convergence is judged on the residual `G(x) − x` itself, not on the
 /// relaxed step (Aitken's steps do not shrink steadily), whole and part by part
 /// ([`relative_change`]); a NaN anywhere makes it NaN.
+///
+/// The residuals shrink by a factor `θ` a pass; the iterate after a pass whose residual is `r`
+/// is then within about `θ/(1 − θ) |r|` of the fixed point. Where that estimate is at round-off
+/// of every part, the iteration stops without a further pass that would only show it: the
+/// stopping criterion of the Newton iterations of implicit Runge–Kutta methods (E. Hairer,
+/// G. Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., Springer 1996, §IV.8), with
+/// the same round-off tolerance as the residual's own test, and `θ` the larger of the last two
+/// observed ratios (the first pass's ratio, from the starting guess, is not trusted alone).
 struct FixedPoint {
     omega: f64,
     /// `r_oldᵀ(r − r_old)` and `|r − r_old|²` of this pass.
@@ -216,6 +224,8 @@ struct FixedPoint {
     parts: f64,
     last_change: f64,
     last_parts: f64,
+    /// The previous pass's contraction ratio (0 before the second).
+    last_theta: f64,
 }
 
 /// What a pass of the fixed point concluded.
@@ -236,6 +246,7 @@ impl FixedPoint {
             parts: 0.0,
             last_change: f64::INFINITY,
             last_parts: f64::INFINITY,
+            last_theta: 0.0,
         }
     }
     /// One stage's residual `r` against the previous pass's `r_old`, for Aitken's factor.
@@ -265,16 +276,22 @@ impl FixedPoint {
         self.parts = self.parts.max(part);
     }
     /// After pass `it`: converged when every part of the stages has stopped moving (a forcing
-    /// independent of the state, `stateful` false, at the first pass), or when the whole is at
-    /// round-off (below 1e-12) and neither measure improves any more.
+    /// independent of the state, `stateful` false, at the first pass), when from the third pass
+    /// on the contraction puts the new iterate within round-off of every part (the estimate of
+    /// the type documentation, `θ < 1/2`), or when the whole is at round-off (below 1e-12) and
+    /// neither measure improves any more.
     fn verdict(&mut self, it: usize, stateful: bool) -> Verdict {
         let (change, parts) = (self.change, self.parts);
         if !change.is_finite() {
             return Verdict::Failed;
         }
+        let ratio = (change / self.last_change).max(parts / self.last_parts);
+        let theta = ratio.max(self.last_theta);
+        let settled = it >= 2 && theta < 0.5 && parts * theta / (1.0 - theta) <= 4.0 * f64::EPSILON;
         if !stateful
             || (it > 0
                 && (parts <= 4.0 * f64::EPSILON
+                    || settled
                     || (change < 1e-12 && change >= self.last_change && parts >= self.last_parts)))
         {
             return Verdict::Converged;
@@ -283,6 +300,7 @@ impl FixedPoint {
             return Verdict::Failed;
         }
         (self.last_change, self.last_parts) = (change, parts);
+        self.last_theta = if ratio.is_nan() { 1.0 } else { ratio };
         Verdict::Continue
     }
 }
@@ -367,4 +385,54 @@ fn energy(f: &Rows, w: &SMatrix<f64, 3, 10>, k: usize) -> f64 {
         + f.fv.component_mul(&w.fixed_view::<3, 3>(0, 3)).sum()
         + f.fw.component_mul(&w.fixed_view::<3, 3>(0, 6)).sum()
         + f.c.dot(&w.column(9))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Feed the fixed point's measures a residual of `change` (whole) and `parts` (by parts)
+    /// per pass, and return the pass at which it stops.
+    fn stops_at(passes: &[(f64, f64)]) -> Option<usize> {
+        let mut fp = FixedPoint::new();
+        for (it, &(change, parts)) in passes.iter().enumerate() {
+            fp.relax();
+            (fp.change, fp.parts) = (change, parts);
+            match fp.verdict(it, true) {
+                Verdict::Continue => {}
+                Verdict::Converged => return Some(it),
+                Verdict::Failed => return None,
+            }
+        }
+        None
+    }
+
+    /// The residuals of the vessel in the mean wind (measured): a contraction of 5e-5 a pass.
+    /// The estimate stops the iteration where the next pass's residual would be at round-off of
+    /// every part, one pass before the residual shows it; a first ratio that is small alone, or
+    /// a slow contraction, does not stop it.
+    #[test]
+    fn the_contraction_estimate_stops_only_at_round_off() {
+        let wind = [
+            (1.2e-3, 1.0e-1),
+            (1.9e-9, 2.7e-7),
+            (9.5e-14, 1.35e-11),
+            (5.0e-18, 7.0e-16),
+            (0.0, 0.0),
+        ];
+        assert_eq!(stops_at(&wind), Some(2));
+        // The same at the third pass with a residual by parts 6e-11: the estimate 3e-15 is not
+        // round-off; the next pass's residual is.
+        let mut later = wind;
+        later[2].1 = 6.0e-11;
+        later[3].1 = 3.0e-15;
+        assert_eq!(stops_at(&later), Some(3));
+        // The first ratio (from the starting guess) alone stops nothing, even where its estimate
+        // would be round-off.
+        assert_eq!(stops_at(&[(1e-3, 1e-3), (1e-13, 1e-13)]), None);
+        // A contraction of 0.6 stops only when the residual itself is at round-off.
+        let slow: Vec<(f64, f64)> = (0..80).map(|k| (0.6f64.powi(k), 0.6f64.powi(k))).collect();
+        let k = stops_at(&slow).unwrap();
+        assert!(0.6f64.powi(k as i32) <= 4.0 * f64::EPSILON, "{k}");
+    }
 }
