@@ -29,9 +29,10 @@ use super::VesselSystem;
 use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
 use std::sync::Mutex;
 
-/// What an assembly depends on, bit for bit: `Q`, the controller's state, and, where a
-/// component's part reads them ([`Force::assembly_reads_motion`](super::super::forces::Force::assembly_reads_motion)). the momenta `p`, `m` and the actuators' memory. An assembly with the
-/// ledger (each account's rows) serves a sub-step without it too.
+/// What an assembly depends on, bit for bit: `Q`, the controller's state, and the momenta `p`,
+/// `m` and the actuators' memory where a component's part reads them
+/// ([`Force::assembly_reads_motion`](super::super::forces::Force::assembly_reads_motion)). An
+/// assembly with the ledger (each account's rows) serves a sub-step without it too.
 #[derive(Clone, Copy)]
 struct Key {
     q: nalgebra::Matrix3<f64>,
@@ -296,8 +297,9 @@ mod tests {
     }
 
     /// What lets the kept assembly leave the momenta and the actuators' memory out of its key
-    /// where no component's part reads them ([`Force::assembly_reads_motion`](super::super::forces::Force::assembly_reads_motion)). each component
-    /// that says so (every one without a forcing part, and the wind), of every preset, of the
+    /// where no component's part reads them
+    /// ([`Force::assembly_reads_motion`](super::super::forces::Force::assembly_reads_motion)):
+    /// each component that says so (every one without a forcing part, and the wind), of every preset, of the
     /// paper's vessel with an external load, a current and a gusting wind, and of the pipe-lay
     /// vessel, gives the same rows at rest and with velocities and a memory.
     #[test]
