@@ -69,27 +69,22 @@ pub struct Phasors {
     key: Key,
 }
 
-struct Anchor {
+/// Factors of one set of components kept by a thread: an anchor `e^{i(ω_k jΔ + φ_k)}` (`at` = `j`)
+/// or the remainders `e^{i ω_k r}` at one offset (`at` = the bits of `r`).
+#[derive(Default)]
+struct Kept {
     key: u64,
-    j: i64,
+    at: u64,
     re: Vec<f64>,
     im: Vec<f64>,
 }
 
-/// The remainder factors `e^{i ω_k r}` of one set of components at one offset `r` (its bits).
-struct Remainder {
-    key: u64,
-    r: u64,
-    re: Vec<f64>,
-    im: Vec<f64>,
-}
-
-/// A thread's memo: recently used anchors and remainders, each the oldest replaced first, and
-/// the result buffers.
+/// A thread's memo: recently used anchors and remainders, each the oldest replaced first (its
+/// buffers reused), and the result buffers.
 struct Memo {
-    anchors: Vec<Anchor>,
+    anchors: Vec<Kept>,
     next: usize,
-    rems: Vec<Remainder>,
+    rems: Vec<Kept>,
     next_rem: usize,
     re: Vec<f64>,
     im: Vec<f64>,
@@ -186,46 +181,17 @@ impl Phasors {
                 re,
                 im,
             } = &mut *memo;
-            let a = match anchors.iter().position(|a| a.key == self.key.0 && a.j == j) {
-                Some(i) => i,
-                None => {
-                    let tj = jf * self.span;
-                    let mut are = vec![0.0; k];
-                    let mut aim = vec![0.0; k];
-                    for i in 0..k {
-                        let (s, c) = (self.omega[i] * tj + self.phase[i]).sin_cos();
-                        are[i] = c;
-                        aim[i] = s;
-                    }
-                    let new = Anchor {
-                        key: self.key.0,
-                        j,
-                        re: are,
-                        im: aim,
-                    };
-                    keep(anchors, next, new)
-                }
-            };
+            let tj = jf * self.span;
+            let a = kept(anchors, next, self.key.0, j as u64, k, |i| {
+                let (s, c) = (self.omega[i] * tj + self.phase[i]).sin_cos();
+                (c, s)
+            });
             // The remainder factors depend on `r` alone: a step size commensurate with `δ`
             // (h = 0.5 s, 0.25 s, 1 s, … and the midpoint rule's nodes) meets a few offsets
             // again and again, which are kept as computed.
-            let rb = r.to_bits();
-            let q = match rems.iter().position(|e| e.key == self.key.0 && e.r == rb) {
-                Some(i) => i,
-                None => {
-                    let (mut rre, mut rim) = (vec![0.0; k], vec![0.0; k]);
-                    for i in 0..k {
-                        (rre[i], rim[i]) = taylor(self.omega[i] * r);
-                    }
-                    let new = Remainder {
-                        key: self.key.0,
-                        r: rb,
-                        re: rre,
-                        im: rim,
-                    };
-                    keep(rems, next_rem, new)
-                }
-            };
+            let q = kept(rems, next_rem, self.key.0, r.to_bits(), k, |i| {
+                taylor(self.omega[i] * r)
+            });
             re.resize(k, 0.0);
             im.resize(k, 0.0);
             let an = &anchors[a];
@@ -249,18 +215,37 @@ impl Phasors {
     }
 }
 
-/// Put `new` in a memo of at most [`MEMO`] entries (replacing the oldest when full, `next` its
-/// index) and return where.
-fn keep<T>(entries: &mut Vec<T>, next: &mut usize, new: T) -> usize {
-    if entries.len() < MEMO {
-        entries.push(new);
+/// The index of the entry of `entries` kept for `(key, at)`; if there is none, one made with
+/// `factor(i)` for `i < k` (the `(cos, sin)` of component `i`), in place of the oldest when the
+/// memo holds [`MEMO`] entries (`next` its index), whose buffers it reuses: no allocation once
+/// the memo is full, however often it misses.
+fn kept(
+    entries: &mut Vec<Kept>,
+    next: &mut usize,
+    key: u64,
+    at: u64,
+    k: usize,
+    factor: impl Fn(usize) -> (f64, f64),
+) -> usize {
+    if let Some(i) = entries.iter().position(|e| e.key == key && e.at == at) {
+        return i;
+    }
+    let i = if entries.len() < MEMO {
+        entries.push(Kept::default());
         entries.len() - 1
     } else {
         let i = *next;
-        entries[i] = new;
         *next = (i + 1) % MEMO;
         i
+    };
+    let e = &mut entries[i];
+    (e.key, e.at) = (key, at);
+    e.re.resize(k, 0.0);
+    e.im.resize(k, 0.0);
+    for c in 0..k {
+        (e.re[c], e.im[c]) = factor(c);
     }
+    i
 }
 
 /// `(cos x, sin x)` for `|x| ≤ 1/4` by the Taylor polynomials of degrees 12 and 13 (Horner in
