@@ -384,3 +384,21 @@ def test_one_default_for_the_controller_start_everywhere(tmp_path):
                  "--control-start", "never"]) == 0
     with phsplit.open_dataset(tmp_path / "empty-t1-cnever.nc") as ds:
         assert "never" in str(ds.attrs.get("control_start", "never"))
+
+
+def test_an_interrupt_that_left_evaluated_code_still_ends_with_status_130(tmp_path):
+    """CPython ends ``python -m`` by SIGINT, not the returned status, once a KeyboardInterrupt
+    has left code evaluated through PyRun_String (netCDF4 and cftime run code that way); the
+    command clears that note after an interrupt. Without the clearing the same module dies by
+    SIGINT (status -2), so the check can fail."""
+    mod = tmp_path / "interrupted_command.py"
+    mod.write_text(
+        "import ctypes, sys\n"
+        "from phsplit import _signals\n"
+        "ctypes.pythonapi.PyRun_SimpleStringFlags(b'raise KeyboardInterrupt', None)\n"
+        "if sys.argv[1] == 'clear':\n"
+        "    _signals.forget_escaped_interrupt()\n"
+        "sys.exit(130)\n")
+    codes = {how: subprocess.run([sys.executable, "-m", "interrupted_command", how], cwd=tmp_path,
+                                 capture_output=True).returncode for how in ("clear", "keep")}
+    assert codes == {"clear": 130, "keep": -signal.SIGINT}

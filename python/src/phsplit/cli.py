@@ -8,6 +8,9 @@ import sys
 import tempfile
 import time
 
+from . import _signals
+
+
 def _check_out_folder(out: str) -> None:
     """``--out`` names a folder that is there or can be made, checked before anything runs."""
     if os.path.exists(out) and not os.path.isdir(out):
@@ -1028,21 +1031,27 @@ def _vessels() -> int:
     return 0
 
 
-def _sigterm(signum, frame):
-    raise KeyboardInterrupt
-
-
 def main(argv: list[str] | None = None) -> int:
+    rc = _main(argv)
+    if rc != 130 and _signals.received():  # the signal came where Python dropped it
+        print("phsplit: interrupted as the command finished; what it wrote is complete", file=sys.stderr)
+        rc = 130
+    if rc == 130:
+        _signals.forget_escaped_interrupt()
+    return rc
+
+
+def _main(argv: list[str] | None) -> int:
     import signal
 
     import phsplit
 
     try:
         if signal.getsignal(signal.SIGINT) is phsplit._early_signal:  # the command's own start
-            signal.signal(signal.SIGINT, signal.default_int_handler)
-            signal.signal(signal.SIGTERM, _sigterm)
+            signal.signal(signal.SIGINT, _signals.handler)
+            signal.signal(signal.SIGTERM, _signals.handler)
         if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
-            signal.signal(signal.SIGTERM, _sigterm)  # clean up staging files as on Ctrl-C
+            signal.signal(signal.SIGTERM, _signals.handler)  # clean up staging files as on Ctrl-C
         import warnings
 
         def _show(message, category, filename, lineno, file=None, line=None):

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _core, cf
+from . import _core, _signals, cf
 from .runner import StepSizeWarning
 from .settings import Settings
 from .simulate import simulate
@@ -728,6 +728,8 @@ def reproduce(out: str, quick: bool = False, progress: bool = True, vessel: Vess
         if main_thread:
             signal.pthread_sigmask(signal.SIG_BLOCK, sigs)
         try:
+            if _signals.received():  # an interrupt Python dropped on the way: still nothing published
+                raise KeyboardInterrupt
             umask = os.umask(0)
             os.umask(umask)
             for name in sorted(os.listdir(stage)):
