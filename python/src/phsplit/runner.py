@@ -189,7 +189,7 @@ def run(vessel: Vessel, settings: Settings, y0: np.ndarray | None = None, *, ort
     state when None). ``continuing``: ``y0`` is the last state of an earlier call of the same
     run (chunks, ``save_at``, events, ``Solution.at``), taken as it is, only checked to be finite.
     ``callback(steps_done, n_steps)`` is called as the core goes. ``stacklevel`` places the
-    warnings at the user's call. ``save_at``: output times an adaptive run lands on."""
+    warnings at the user's call. ``save_at``: an adaptive run's output times."""
     _warn_if_step_too_long(vessel, y0, settings, stacklevel)
     raw = _core.integrate(vessel._inner, settings.as_core(), y0, bool(orthonormalize), callback, bool(running_max),
                           bool(continuing and y0 is not None), save_at)

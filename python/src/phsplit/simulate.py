@@ -174,7 +174,7 @@ def simulate(
             "rtol and atol")
     adaptive_at = None
     if settings.adaptive and save_at is not None:
-        # The core's adaptive steps land on the output times themselves.
+        # The core computes the output times itself, without cutting its adaptive steps.
         from .events import _check_times
 
         if settings.save_every != 1:

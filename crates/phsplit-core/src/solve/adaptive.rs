@@ -19,11 +19,19 @@
 //! Differential Equations II*, 2nd ed., §IV.2, eq. (2.43c) and the remarks after it;
 //! K. Gustafsson, ACM TOMS 17, 1991).
 //!
-//! **Times.** Steps land exactly on the end of the run, on the requested output times
-//! ([`Tolerance::save_at`]: the states there are computed, not interpolated) and on the model's
-//! switches and events ([`super::system::Model::next_switch`]: the controller turned on, a
-//! sensor's sample, a thruster lost), so each acts where it is due, not at the next step
-//! boundary after it.
+//! **Times.** Steps land exactly on the end of the run and on the model's switches and events
+//! ([`super::system::Model::next_switch`]: the controller turned on, a sensor's sample, a
+//! thruster lost), so each acts where it is due, not at the next step boundary after it.
+//!
+//! **Output times** ([`Tolerance::save_at`]) do not cut the steps: the state at an output time
+//! `s` inside an accepted step from `t` is one step of the method of length `s − t` from the
+//! accepted state at `t` (computed, not interpolated), as fixed steps give their `save_at`
+//! states (`phsplit.events`), or two halves of it where `s − t > 2^{−p/(p+1)} h`: so its local
+//! error, to leading order, is at most the accepted step's, which the controller bounds. The
+//! run's own steps are the same with outputs as without, so dense outputs cost one or two
+//! short steps each, not a cap on the step size. Ledger: the row of an output is the accepted path's booking
+//! up to `t` plus the short step's own booking, less what the previous output booked past
+//! `t`, so `ΔH = supplied − dissipated` holds between any two saved states as between steps.
 
 use super::options::{Options, Tolerance};
 use super::system::{Flow, SplitModel, Work};
@@ -48,6 +56,7 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     let p = method.order as i32;
     let k = f64::from(p + 1);
     let richardson = f64::from(2i32.pow(p as u32) - 1);
+    let one_piece = 2f64.powf(-f64::from(p) / k);
     let mut y = y0;
     model.begin(opts.t0, &mut y);
     if model.error_norm(&y, &y, &y, tol.rtol, tol.atol).is_none() {
@@ -70,15 +79,12 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     // steps cannot resolve): the run stops as failed instead of creeping on.
     let h_min = resolution.max(1e-10 * span);
     // The trials' states, reused from trial to trial (a model's state may own a heap part).
-    let (mut whole, mut halves) = (y.clone(), y.clone());
+    let (mut whole, mut halves, mut branch) = (y.clone(), y.clone(), y.clone());
     let saves = &tol.save_at;
     let mut next_save = saves.partition_point(|&ts| ts <= t0 + resolution);
     loop {
         let mut hn = h;
         let mut to = t1;
-        if let Some(&ts) = saves.get(next_save) {
-            to = to.min(ts);
-        }
         if let Some(ts) = model.next_switch(t).filter(|&ts| ts > t + resolution) {
             to = to.min(ts);
         }
@@ -87,7 +93,6 @@ pub fn run_splitting_adaptive<M: SplitModel>(
             hn = to - t;
         }
         let last = clipped && to == t1;
-        let at_save = clipped && saves.get(next_save) == Some(&to);
         whole.clone_from(&y);
         // The whole step is only compared: its ledger is not needed.
         one_step(model, &subs, method.order, false, hn, t, &mut whole);
@@ -153,11 +158,45 @@ pub fn run_splitting_adaptive<M: SplitModel>(
             }
             continue;
         }
-        // Accepted: the two halves.
+        // Accepted: the two halves; `halves` keeps the step's start for the outputs inside it.
         std::mem::swap(&mut y, &mut halves);
-        rec.acc += w;
-        accepted += 1;
+        let t_start = t;
         t = if clipped { to } else { t + hn };
+        let mut past_start = Work::default(); // booked past `t_start` by the outputs saved so far
+        while let Some(&ts) = saves.get(next_save).filter(|&&ts| ts < t - resolution) {
+            branch.clone_from(&halves);
+            let tau = ts - t_start;
+            // One step while its local error, C τ^{p+1}, is at most the accepted halves',
+            // C hₙ^{p+1}/2ᵖ; else two halves, as the accepted step.
+            let pieces = if tau <= one_piece * hn { 1 } else { 2 };
+            let mut wb = Work::default();
+            for i in 0..pieces {
+                let len = tau / pieces as f64;
+                wb += one_step(
+                    model,
+                    &subs,
+                    method.order,
+                    opts.ledger,
+                    len,
+                    t_start + i as f64 * len,
+                    &mut branch,
+                );
+            }
+            if !model.is_finite(&branch) {
+                rec.traj.steps = accepted;
+                rec.traj.rejected = rejected;
+                return Ok(rec.fail(accepted, t_start));
+            }
+            rec.acc += &wb;
+            rec.acc += past_start.scaled(-1.0);
+            rec.save(ts, branch.clone());
+            past_start = wb;
+            next_save += 1;
+        }
+        rec.acc += w;
+        rec.acc += past_start.scaled(-1.0);
+        accepted += 1;
+        let at_save = saves.get(next_save).is_some_and(|&ts| ts <= t + resolution);
         rec.traj.steps = accepted;
         rec.traj.rejected = rejected;
         rec.traj.last_good.clone_from(&y);
@@ -168,7 +207,7 @@ pub fn run_splitting_adaptive<M: SplitModel>(
         }
         let saved = last || at_save || (saves.is_empty() && accepted % opts.save_every == 0);
         if saved {
-            rec.save(t, y.clone());
+            rec.save(if at_save { saves[next_save - 1] } else { t }, y.clone());
         }
         if last {
             return Ok(rec.traj);
@@ -347,36 +386,60 @@ mod tests {
         assert!(e.to_string().contains("splitting methods"), "{e}");
     }
 
-    /// Output times: the steps land on them exactly, only they are saved (with the start and
-    /// the end), and the states there are the method's within the tolerance.
+    /// Output times: only they are saved (with the start and the end), at exactly those times;
+    /// the run takes the same steps as without them; the states there are the method's within
+    /// the tolerance; and the ledger closes between any two of them, also between two outputs
+    /// inside one step.
     #[test]
-    fn output_times_are_landed_on() {
+    fn output_times_do_not_cut_the_steps() {
         let m: Method = "sp4".parse().unwrap();
-        let save_at: Vec<f64> = (1..=7).map(|k| 2.5 * k as f64).collect();
-        let opts = Options {
+        let tolerance = |save_at: Vec<f64>| Options {
             tolerance: Some(Tolerance {
                 rtol: 1e-8,
                 atol: 1e-8,
                 h_max: 20.0,
                 t1: 20.0,
-                save_at: save_at.clone(),
+                save_at,
             }),
             ..Options::steps(0.0, 0.1, 200, 1)
         };
-        let tr = run(&Osc { growth: None }, &m, [1.0, -0.5], &opts).unwrap();
+        let plain = run(
+            &Osc { growth: None },
+            &m,
+            [1.0, -0.5],
+            &tolerance(Vec::new()),
+        )
+        .unwrap();
+        // Outputs every 0.05 s: several inside each step.
+        let save_at: Vec<f64> = (1..400).map(|k| 0.05 * k as f64).collect();
+        let tr = run(
+            &Osc { growth: None },
+            &m,
+            [1.0, -0.5],
+            &tolerance(save_at.clone()),
+        )
+        .unwrap();
         let mut want = vec![0.0];
         want.extend(&save_at);
         want.push(20.0);
         assert_eq!(tr.t, want);
-        for (t, y) in tr.t.iter().zip(&tr.states) {
-            let ex = exact(*t, [1.0, -0.5]);
+        assert_eq!(tr.steps, plain.steps);
+        assert!(tr.steps < 100, "{} steps for 400 outputs", tr.steps);
+        assert_eq!(tr.states.last(), plain.states.last());
+        for i in 0..tr.t.len() {
+            let (t, y) = (tr.t[i], tr.states[i]);
+            let ex = exact(t, [1.0, -0.5]);
             assert!(
                 (y[0] - ex[0]).abs() < 1e-6,
                 "t = {t}: {} vs {}",
                 y[0],
                 ex[0]
             );
+            if i > 0 {
+                let dh = tr.energy[i] - tr.energy[i - 1];
+                let booked = tr.supplied[i] - tr.dissipated[i];
+                assert!((dh - booked).abs() < 1e-13, "t = {t}: {dh} vs {booked}");
+            }
         }
-        assert!(tr.steps > save_at.len() + 1);
     }
 }
