@@ -5,9 +5,9 @@ grid ``t0 + k h``, and the state at a time ``s`` between grid points ``t_k < s <
 step of the method of length ``s − t_k`` from the grid state at ``t_k``, the very computation a
 run with ``t_span = (t0, s)`` ends with (its last, shorter step). So every ``save_at`` state
 has the method's order, and none is interpolated. The grid run itself is not changed by it.
-With adaptive steps (``rtol``, ``atol``) the core does the same on its accepted steps: an
-output inside one is a step from the accepted state before it, or two halves of that step when
-it is long, so its error stays within the tolerance (docs/numerics.md, "Adaptive steps").
+With adaptive steps (``rtol``, ``atol``) the core does the same on its accepted steps (each two
+halves): an output inside one is a step from the run's last state before it, at most half the
+accepted length, so its error stays within the tolerance (docs/numerics.md, "Adaptive steps").
 
 Events: a condition ``g(t, state) = 0`` watched after every step. A crossing between two grid
 points is located by the Illinois variant of regula falsi on the length ``τ`` of a partial step

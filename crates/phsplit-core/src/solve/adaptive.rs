@@ -24,14 +24,15 @@
 //! thruster lost), so each acts where it is due, not at the next step boundary after it.
 //!
 //! **Output times** ([`Tolerance::save_at`]) do not cut the steps: the state at an output time
-//! `s` inside an accepted step from `t` is one step of the method of length `s − t` from the
-//! accepted state at `t` (computed, not interpolated), as fixed steps give their `save_at`
-//! states (`phsplit.events`), or two halves of it where `s − t > 2^{−p/(p+1)} h`: so its local
-//! error, to leading order, is at most the accepted step's, which the controller bounds. The
-//! run's own steps are the same with outputs as without, so dense outputs cost one or two
-//! short steps each, not a cap on the step size. Ledger: the row of an output is the accepted path's booking
-//! up to `t` plus the short step's own booking, less what the previous output booked past
-//! `t`, so `ΔH = supplied − dissipated` holds between any two saved states as between steps.
+//! `s` inside an accepted step is one step of the method from the last state of the run before
+//! `s`, the step's start `t` or the end of its first half `t + h/2` (computed, not
+//! interpolated), as fixed steps give their `save_at` states (`phsplit.events`). That step is at
+//! most `h/2` long, so its local error is at most the accepted halves', which the controller
+//! bounds. The run's own steps are the same with outputs as without, so dense outputs cost one
+//! short step each, not a cap on the step size. Ledger: the row of an output is the run's
+//! booking up to the branch's start plus the short step's own booking, less what the previous
+//! output booked past the start of the accepted step, so `ΔH = supplied − dissipated` holds
+//! between any two saved states as between steps.
 
 use super::options::{Options, Tolerance};
 use super::system::{Flow, SplitModel, Work};
@@ -56,7 +57,6 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     let p = method.order as i32;
     let k = f64::from(p + 1);
     let richardson = f64::from(2i32.pow(p as u32) - 1);
-    let one_piece = 2f64.powf(-f64::from(p) / k);
     let mut y = y0;
     model.begin(opts.t0, &mut y);
     if model.error_norm(&y, &y, &y, tol.rtol, tol.atol).is_none() {
@@ -79,7 +79,8 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     // steps cannot resolve): the run stops as failed instead of creeping on.
     let h_min = resolution.max(1e-10 * span);
     // The trials' states, reused from trial to trial (a model's state may own a heap part).
-    let (mut whole, mut halves, mut branch) = (y.clone(), y.clone(), y.clone());
+    let (mut whole, mut halves) = (y.clone(), y.clone());
+    let (mut mid, mut branch) = (y.clone(), y.clone());
     let saves = &tol.save_at;
     let mut next_save = saves.partition_point(|&ts| ts <= t0 + resolution);
     loop {
@@ -107,6 +108,18 @@ pub fn run_splitting_adaptive<M: SplitModel>(
             &mut halves,
         );
         let finite_half = model.is_finite(&halves);
+        // The first half's end and booking, kept when an output falls inside this step.
+        let mid_needed = saves
+            .get(next_save)
+            .is_some_and(|&ts| ts < t + hn - resolution);
+        let w_first = if mid_needed {
+            w.clone()
+        } else {
+            Work::default()
+        };
+        if finite_half && mid_needed {
+            mid.clone_from(&halves);
+        }
         if finite_half {
             w += one_step(
                 model,
@@ -163,29 +176,31 @@ pub fn run_splitting_adaptive<M: SplitModel>(
         let t_start = t;
         t = if clipped { to } else { t + hn };
         let mut past_start = Work::default(); // booked past `t_start` by the outputs saved so far
+        let t_mid = t_start + 0.5 * hn;
         while let Some(&ts) = saves.get(next_save).filter(|&&ts| ts < t - resolution) {
-            branch.clone_from(&halves);
-            let tau = ts - t_start;
-            // One step while its local error, C τ^{p+1}, is at most the accepted halves',
-            // C hₙ^{p+1}/2ᵖ; else two halves, as the accepted step.
-            let pieces = if tau <= one_piece * hn { 1 } else { 2 };
-            let mut wb = Work::default();
-            for i in 0..pieces {
-                let len = tau / pieces as f64;
+            // From the step's start or from its midpoint, whichever is the last before `ts`:
+            // one step of at most half the accepted length.
+            let (from, t_from, mut wb) = if ts <= t_mid {
+                (&halves, t_start, Work::default())
+            } else {
+                (&mid, t_mid, w_first.clone())
+            };
+            branch.clone_from(from);
+            if ts - t_from > resolution {
                 wb += one_step(
                     model,
                     &subs,
                     method.order,
                     opts.ledger,
-                    len,
-                    t_start + i as f64 * len,
+                    ts - t_from,
+                    t_from,
                     &mut branch,
                 );
             }
             if !model.is_finite(&branch) {
                 rec.traj.steps = accepted;
                 rec.traj.rejected = rejected;
-                return Ok(rec.fail(accepted, t_start));
+                return Ok(rec.fail(accepted, t_from));
             }
             rec.acc += &wb;
             rec.acc += past_start.scaled(-1.0);
