@@ -128,3 +128,35 @@ def test_save_at_rows_keep_the_ledger_between_them():
     np.testing.assert_array_equal(sol.t, ts)
     assert np.max(sol.ledger.relative_residual()) < 1e-12
     assert sol.ledger.dH[0] == 0.0 and np.all(sol.ledger.by_account["damping"][1:] > 0.0)
+
+
+def test_events_on_adaptive_steps_against_an_independent_model():
+    """The paper's vessel entering a 30 m circle about its set point (DP on from t = 0): the
+    crossing time of adaptive SP2 against scipy's DOP853 event on the independent numpy model,
+    closer at the tighter tolerance; the run ends there with its ledger closed; a non-terminal
+    event is recorded and the run goes on to the end, saving every accepted step."""
+    f = ref.Field(V.to_dict(), True)
+    xr = f.xr
+
+    def inside(t, y):
+        return np.hypot(y[18] - xr[0], y[19] - xr[1]) - 30.0
+
+    inside.terminal, inside.direction = True, -1
+    scale = np.maximum(np.abs(Y0), 1.0)
+    exact = solve_ivp(f, (0.0, 200.0), Y0, method="DOP853", rtol=1e-12, atol=1e-12 * scale, events=inside)
+    t_exact = float(exact.t_events[0][0])
+    errs = []
+    for tol in (1e-3, 1e-6):
+        sol = phsplit.simulate(V, (0.0, 200.0), 0.5, "sp2", control_start=0.0, rtol=tol, atol=tol,
+                               events=[phsplit.events.watch_circle(30.0, direction="enter")])
+        assert sol.status == "event" and sol.t[-1] == sol.meta["events"][0].t
+        errs.append(abs(sol.t[-1] - t_exact))
+        assert np.hypot(*(sol.x[-1, :2] - xr[:2])) == pytest.approx(30.0, abs=1e-9)
+        assert np.max(sol.ledger.relative_residual()) < 1e-10
+    assert errs[1] < errs[0] and errs[1] < 1e-5, (errs, t_exact)
+    marked = phsplit.simulate(V, (0.0, 200.0), 0.5, "sp2", control_start=0.0, atol=1e-4,
+                              events=[phsplit.events.watch_circle(30.0, direction="enter", terminal=False)])
+    plain = phsplit.simulate(V, (0.0, 200.0), 0.5, "sp2", control_start=0.0, atol=1e-4)
+    assert marked.status == "completed" and len(marked.meta["events"]) == 1
+    np.testing.assert_array_equal(marked.t, plain.t)
+    assert abs(marked.meta["events"][0].t - t_exact) < 1e-2

@@ -13,7 +13,10 @@ Events: a condition ``g(t, state) = 0`` watched after every step. A crossing bet
 points is located by the Illinois variant of regula falsi on the length ``τ`` of a partial step
 from the grid state before it (each trial one method step of length ``τ``), to ``|Δτ| ≤ 1e-12
 s``. The crossing time is then as accurate as the method's states are. A terminal event ends the
-run at the crossing; otherwise it is recorded and the run goes on. Built-in conditions:
+run at the crossing; otherwise it is recorded and the run goes on. With adaptive steps
+(``rtol``, ``atol``) the accepted steps take the grid's place, and each trial is the partial
+step taken as two halves, as the accepted steps are, so the crossing is within the tolerance
+(the run is computed to its end and cut at a terminal event). Built-in conditions:
 :func:`watch_circle` (horizontal distance to the set point), :func:`roll_beyond`,
 :func:`pitch_beyond`, :func:`energy_above`; any callable ``g(t, y)`` on the flat 27-vector state (followed, for a vessel with rate-limited
 thrusters, by their memory: see :meth:`Solution.state`)
@@ -310,6 +313,8 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                     status, failure = p.status, p.failure
                     break
                 rows.add(p, -1, cum + _booked_steps(p, names).sum(axis=0), t=s)
+    elif settings.adaptive:
+        return _events_on_adaptive_steps(vessel, settings, y, events, names)
     else:
         k, cum = 0, np.zeros(len(names))
         chunk = max(settings.save_every, 20_000 // settings.save_every * settings.save_every)
@@ -351,20 +356,20 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
     return _assemble(rows, names, status, failure, hits, steps, settings)
 
 
-def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, names):
+def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, names, pieces: int = 1):
     """The crossing of ``ev`` within the step of length ``h`` from ``(t_a, y_a)``: Illinois
-    regula falsi on the partial-step length, to |Δτ| ≤ 1e-12 s (or 60 iterations). Returns the
-    time, the core call that ends there, and its booking."""
+    regula falsi on the partial-step length, to |Δτ| ≤ 1e-12 s (or 60 iterations), each trial
+    ``pieces`` equal steps. Returns the time, the core call that ends there, and its booking."""
 
     def at(tau):
-        return _call(vessel, settings, t_a, t_a + tau, tau, y_a, 1)
+        return _call(vessel, settings, t_a, t_a + tau, tau / pieces, y_a, pieces)
 
     lo, hi = 0.0, h
     best = at(h)
     g_lo, g_hi = ev.value(t_a, y_a, vessel), ev.value(t_a + h, best.state(-1), vessel)
     side = 0
     # The shortest partial step the times of the run resolve (the core refuses shorter ones).
-    tol = max(1e-12, 1024.0 * np.finfo(float).eps * max(1.0, abs(t_a) + h))
+    tol = pieces * max(1e-12, 1024.0 * np.finfo(float).eps * max(1.0, abs(t_a) + h))
     for _ in range(60):
         if hi - lo <= tol:
             break
@@ -385,6 +390,41 @@ def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, 
                 g_hi *= 0.5
             side = -1
     return t_a + hi, best, _booked_steps(best, names).sum(axis=0)
+
+
+def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names):
+    """Events on adaptive steps: the run is one core call to its end, saving every accepted
+    step; a crossing between two accepted states is located as on the fixed grid, each trial a
+    partial step from the accepted state before it taken as two halves, the accepted steps' own
+    form, so its local error stays within what the controller accepted; a terminal event cuts
+    the run there (the steps after it were computed and are dropped). Rows: every
+    ``save_every``-th accepted step, the end, and each terminal event."""
+    from dataclasses import replace
+
+    t0, t1 = settings.t_span
+    g = _call(vessel, replace(settings, save_every=1), t0, t1, settings.h, y, 1)
+    fixed = replace(settings, rtol=None, atol=None, h_max=None)
+    cum_at = np.cumsum(_booked_steps(g, names), axis=0)
+    rows, hits = _Rows(), []
+    status, failure, steps = g.status, g.failure, g.steps
+    rows.add(g, 0, cum_at[0])
+    t = np.asarray(g.t, dtype=float)
+    for i in range(1, len(t)):
+        ya, yb = g.state(i - 1), g.state(i)
+        found = []
+        for ev in events:
+            if ev.crosses(ev.value(float(t[i - 1]), ya, vessel), ev.value(float(t[i]), yb, vessel)):
+                found.append((*_locate(vessel, fixed, ev, float(t[i - 1]), ya, float(t[i] - t[i - 1]), names,
+                                       pieces=2), ev))
+        found.sort(key=lambda f: f[0])
+        for te, part, w, ev in found:
+            hits.append(EventHit(ev.name, te, part.state(-1), ev.terminal))
+            if ev.terminal:
+                rows.add(part, -1, cum_at[i - 1] + w, t=te)
+                return _assemble(rows, names, "event", None, hits, i - 1, settings)
+        if i % settings.save_every == 0 or i == len(t) - 1:
+            rows.add(g, i, cum_at[i])
+    return _assemble(rows, names, status, failure, hits, steps, settings)
 
 
 def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
@@ -418,9 +458,9 @@ def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
 
 
 def only_times(sol, times: np.ndarray, settings):
-    """An adaptive run that landed on ``times`` (with its start and end) cut to exactly those
-    rows, the ledger between them, as ``save_at`` with fixed steps gives them (numpy slices of
-    the one call's arrays)."""
+    """An adaptive run saved at ``times`` (with its start and end) cut to exactly those rows,
+    the ledger between them, as ``save_at`` with fixed steps gives them (numpy slices of the one
+    call's arrays)."""
     names = list(sol.ledger.by_account)
     per_step = _booked_steps(sol, names)
     idx = np.flatnonzero(np.isin(sol.t, np.asarray(times, dtype=float)))

@@ -168,10 +168,6 @@ def simulate(
     if save_at is not None and settings.save_every != 1:
         raise _core.InvalidInputError(f"save_at gives the saved times itself, so save_every = {settings.save_every!r} "
                                       f"would not be used: give one of them")
-    if settings.adaptive and events:
-        raise _core.InvalidInputError(
-            "events are located on a fixed step grid; with adaptive steps (rtol, atol) drop the events, or "
-            "rtol and atol")
     adaptive_at = None
     if settings.adaptive and save_at is not None:
         # The core computes the output times itself, without cutting its adaptive steps.
