@@ -160,3 +160,18 @@ def test_events_on_adaptive_steps_against_an_independent_model():
     assert marked.status == "completed" and len(marked.meta["events"]) == 1
     np.testing.assert_array_equal(marked.t, plain.t)
     assert abs(marked.meta["events"][0].t - t_exact) < 1e-2
+
+
+def test_states_between_an_adaptive_runs_rows_follow_its_tolerance(exact_positions):
+    """``Solution.at`` on an adaptive run steps adaptively, to the run's tolerance, from the last
+    saved state: against the independent model the error falls with the tolerance and stays
+    below 20·tol (as the run's own rows do)."""
+    errs = []
+    for tol in (1e-3, 1e-5):
+        sol = phsplit.simulate(V, (0.0, T_END), 0.5, "sp2", control_start=0.0, rtol=tol, atol=tol)
+        assert not np.isin(TS, sol.t).all()  # the times asked for are not all rows of the run
+        at = sol.at(TS)
+        np.testing.assert_array_equal(at.t, TS)
+        errs.append(float(np.linalg.norm(at.x - exact_positions, axis=1).max()))
+        assert errs[-1] < 20 * tol, (tol, errs)
+    assert errs[1] < errs[0] / 10, errs

@@ -508,7 +508,9 @@ def dense_output(sol, times):
     base = Settings(t_span=tuple(sol.settings["t_span"]), h=sol.h, method=sol.method, control_start=cs,
                     outer=sol.settings["outer"], save_every=1, linear_flow=sol.settings["linear_flow"],
                     ledger=bool(sol.settings["ledger"]),
-                    project_invariants=bool(sol.settings.get("project_invariants", True)))
+                    project_invariants=bool(sol.settings.get("project_invariants", True)),
+                    # an adaptive run's states between its saved ones: adaptive steps to its tolerance
+                    rtol=sol.settings.get("rtol"), atol=sol.settings.get("atol"), h_max=sol.settings.get("h_max"))
     names = list(sol.ledger.by_account)
     rows = _Rows()
     zero = np.zeros(len(names))

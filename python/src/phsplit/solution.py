@@ -156,8 +156,9 @@ class Solution:
     def at(self, times: Sequence[float] | np.ndarray) -> "Solution":
         """Dense output on request: the states at any ``times`` within the run, each computed by
         stepping from the last saved state at or before it with the run's step and a last,
-        shorter step (as ``save_at`` does), so with the method's own order and no interpolation.
-        One core call per time. The result's ledger is zero (states only)."""
+        shorter step (as ``save_at`` does), so with the method's own order and no interpolation;
+        for an adaptive run, by adaptive steps to the run's tolerance, ending on the time. One
+        core call per time. The result's ledger is zero (states only)."""
         return _provided.get("dense_output")(self, times)
 
     @property
