@@ -224,15 +224,17 @@ def _check_times(save_at, t0: float, t1: float) -> np.ndarray:
 
 
 class _Rows:
-    """Rows taken from the Solutions of several core calls, with the cumulative ledger at each."""
+    """Rows taken from the Solutions of several core calls, each with the energy booked since the
+    row before it, summed over that interval only: a difference of running totals would lose
+    the digits of a settled hour's small bookings to the transient's large ones."""
 
     def __init__(self):
         self.rows: list[tuple[Any, int, float]] = []  # (solution, index, time)
-        self.cum: list[np.ndarray] = []
+        self.booked: list[np.ndarray] = []
 
-    def add(self, sol, i: int, cum: np.ndarray, t: float | None = None):
+    def add(self, sol, i: int, booked: np.ndarray, t: float | None = None):
         self.rows.append((sol, i, float(sol.t[i]) if t is None else float(t)))
-        self.cum.append(np.array(cum, dtype=float))
+        self.booked.append(np.array(booked, dtype=float))
 
 
 def _booked_steps(sol, names) -> np.ndarray:
@@ -288,44 +290,48 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
 
     if save_at is not None:
         ts = _check_times(save_at, t0, t1)
-        k, cum = 0, np.zeros(len(names))
+        # pending: booked since the last row, up to the grid point k (less what that row's
+        # partial step booked past its grid point)
+        k, pending = 0, np.zeros(len(names))
         for s in ts:
             kk = min(int(np.floor((s - t0) / h * (1.0 + 1e-12))), n_steps)
             if t_at(kk) > s:  # round-off put the grid point past s
                 kk -= 1
             if kk > k:
                 g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 10**9)
-                cum = cum + _booked_steps(g, names).sum(axis=0)
+                pending = pending + _booked_steps(g, names).sum(axis=0)
                 steps += g.steps
                 if g.status != "completed":
                     status, failure = g.status, g.failure
-                    rows.add(g, -1, cum)  # the last state before the failure, as plain simulate returns it
+                    rows.add(g, -1, pending)  # the last state before the failure, as plain simulate returns it
                     break
                 y, k = g.last_good_state, kk
             tg = t_at(k)
             tol = 1e-12 * max(1.0, abs(tg))
             if abs(s - tg) <= tol:
                 p = _call(vessel, settings, tg, tg + h, h, y, 1)  # its row 0 is y itself
-                rows.add(p, 0, cum, t=s)
+                rows.add(p, 0, pending, t=s)
+                pending = np.zeros(len(names))
             else:
                 p = _call(vessel, settings, tg, s, s - tg, y, 1)
                 if p.status != "completed":
                     status, failure = p.status, p.failure
                     break
-                rows.add(p, -1, cum + _booked_steps(p, names).sum(axis=0), t=s)
+                part = _booked_steps(p, names).sum(axis=0)
+                rows.add(p, -1, pending + part, t=s)
+                pending = -part
     elif settings.adaptive:
         return _events_on_adaptive_steps(vessel, settings, y, events, names)
     else:
-        k, cum = 0, np.zeros(len(names))
+        k, pending = 0, np.zeros(len(names))  # booked since the last row
         chunk = max(settings.save_every, 20_000 // settings.save_every * settings.save_every)
         done = False
         while k < n_steps and not done:
             kk = min(k + chunk, n_steps)
             g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 1)
             b = _booked_steps(g, names)
-            cum_at = cum + np.cumsum(b, axis=0)
             if k == 0:
-                rows.add(g, 0, cum_at[0])
+                rows.add(g, 0, b[0])
             for i in range(1, len(g.t)):
                 ya, yb = g.state(i - 1), g.state(i)
                 found = []
@@ -337,22 +343,24 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                 for te, part, w, ev in found:
                     hits.append(EventHit(ev.name, te, part.state(-1), ev.terminal))
                     if ev.terminal:
-                        rows.add(part, -1, cum_at[i - 1] + w, t=te)
+                        rows.add(part, -1, pending + w, t=te)
                         status, done = "event", True
                         steps = k + i - 1
                         break
                 if done:
                     break
+                pending = pending + b[i]
                 step_index = k + i
                 if step_index % settings.save_every == 0 or step_index == n_steps or i == len(g.t) - 1 and g.status != "completed":
-                    rows.add(g, i, cum_at[i])
+                    rows.add(g, i, pending)
+                    pending = np.zeros(len(names))
             if done:
                 break
             steps = k + g.steps
             if g.status != "completed":
                 status, failure = g.status, g.failure
                 break
-            y, k, cum = g.last_good_state, kk, cum_at[-1]
+            y, k = g.last_good_state, kk
     return _assemble(rows, names, status, failure, hits, steps, settings)
 
 
@@ -404,10 +412,11 @@ def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names):
     t0, t1 = settings.t_span
     g = _call(vessel, replace(settings, save_every=1), t0, t1, settings.h, y, 1)
     fixed = replace(settings, rtol=None, atol=None, h_max=None)
-    cum_at = np.cumsum(_booked_steps(g, names), axis=0)
+    b = _booked_steps(g, names)
+    pending = np.zeros(len(names))  # booked since the last row
     rows, hits = _Rows(), []
     status, failure, steps = g.status, g.failure, g.steps
-    rows.add(g, 0, cum_at[0])
+    rows.add(g, 0, b[0])
     t = np.asarray(g.t, dtype=float)
     for i in range(1, len(t)):
         ya, yb = g.state(i - 1), g.state(i)
@@ -420,22 +429,24 @@ def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names):
         for te, part, w, ev in found:
             hits.append(EventHit(ev.name, te, part.state(-1), ev.terminal))
             if ev.terminal:
-                rows.add(part, -1, cum_at[i - 1] + w, t=te)
+                rows.add(part, -1, pending + w, t=te)
                 return _assemble(rows, names, "event", None, hits, i - 1, settings)
+        pending = pending + b[i]
         if i % settings.save_every == 0 or i == len(t) - 1:
-            rows.add(g, i, cum_at[i])
+            rows.add(g, i, pending)
+            pending = np.zeros(len(names))
     return _assemble(rows, names, status, failure, hits, steps, settings)
 
 
 def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
-    """One Solution of the recorded rows; the ledger between rows from the cumulative booking."""
+    """One Solution of the recorded rows and the energy booked between them (none before the first)."""
     if not rows.rows:
         raise _core.InvalidInputError("nothing was computed: the run failed at its first step")
     src = rows.rows
     pick = {f: np.array([getattr(s, f)[i] for s, i, _ in src]) for f in _FIELDS}
     t = np.array([tt for _, _, tt in src])
-    cum = np.array(rows.cum).reshape(len(src), len(names))
-    booked = np.vstack([np.zeros((1, len(names))), np.diff(cum, axis=0)])
+    booked = np.array(rows.booked, dtype=float).reshape(len(src), len(names))
+    booked[0] = 0.0
     tmpl = src[-1][0]
     kinds = tmpl.ledger.kinds
     by_account = {nm: booked[:, k] for k, nm in enumerate(names)}
