@@ -165,3 +165,19 @@ def test_the_ledger_between_rows_keeps_its_digits_over_a_settled_hour():
         s = phsplit.simulate(v, (0.0, 3600.0), 0.5, "sp2", control_start=0.0, **kw)
         assert s.status == "completed", what
         assert np.max(s.ledger.relative_residual()) < 1e-10, (what, np.max(s.ledger.relative_residual()))
+
+
+def test_progress_is_reported_over_the_whole_run_with_save_at_and_events():
+    """``progress`` acts with save_at and events too (several core calls): the steps done grow
+    over the whole run, not restarting at each call, and stay within the run's steps."""
+    for kw in (dict(save_at=[100.0, 200.0, 299.9]),
+               dict(events=[phsplit.events.watch_circle(1e4)]),
+               dict(events=[phsplit.events.watch_circle(1e4)], atol=1e-9, rtol=1e-9)):
+        calls = []
+        s = phsplit.simulate(V, (0.0, 300.0), 0.002, "sp2", control_start=0.0, ledger=False,
+                             progress=lambda done, n: calls.append((done, n)), **kw)
+        assert s.status == "completed", kw
+        assert calls, kw
+        done = [d for d, _ in calls]
+        assert all(b >= a for a, b in zip(done, done[1:])) and done[-1] > 150_000 // 2, (kw, done)
+        assert all(n == 150_000 and 0 < d <= n for d, n in calls), (kw, calls[-3:])

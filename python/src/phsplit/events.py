@@ -242,13 +242,14 @@ def _booked_steps(sol, names) -> np.ndarray:
     return np.array([sol.ledger.by_account[n] for n in names]).T.reshape(len(sol.t), len(names))
 
 
-def _call(vessel, settings, t_a, t_b, h, y, save_every):
+def _call(vessel, settings, t_a, t_b, h, y, save_every, callback=None):
     """One core call of a run cut into several, continuing from the run's own state ``y``."""
-    return continue_from(vessel, settings, t_a, t_b, h, y, save_every)
+    return continue_from(vessel, settings, t_a, t_b, h, y, save_every, callback=callback)
 
 
-def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event] = ()):
-    """``simulate`` with ``save_at`` or ``events`` (see the module documentation)."""
+def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event] = (), callback=None):
+    """``simulate`` with ``save_at`` or ``events`` (see the module documentation).
+    ``callback(steps_done, n_steps)``: the progress over the whole run, as the core calls go."""
     if isinstance(events, Event) or not isinstance(events, (list, tuple, type(None))):
         raise _core.InvalidInputError(f"events must be a list of phsplit.events.Event objects, got "
                                       f"{type(events).__name__}")
@@ -288,6 +289,9 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
     def t_at(k):
         return t1 if k >= n_steps else t0 + k * h
 
+    def from_step(k):  # the progress of a call that starts at grid step k
+        return None if callback is None else (lambda done, _n: callback(k + done, n_steps))
+
     if save_at is not None:
         ts = _check_times(save_at, t0, t1)
         # pending: booked since the last row, up to the grid point k (less what that row's
@@ -298,7 +302,7 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
             if t_at(kk) > s:  # round-off put the grid point past s
                 kk -= 1
             if kk > k:
-                g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 10**9)
+                g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 10**9, from_step(k))
                 pending = pending + _booked_steps(g, names).sum(axis=0)
                 steps += g.steps
                 if g.status != "completed":
@@ -306,6 +310,8 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                     rows.add(g, -1, pending)  # the last state before the failure, as plain simulate returns it
                     break
                 y, k = g.last_good_state, kk
+                if callback is not None:
+                    callback(k, n_steps)
             tg = t_at(k)
             tol = 1e-12 * max(1.0, abs(tg))
             if abs(s - tg) <= tol:
@@ -321,14 +327,14 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                 rows.add(p, -1, pending + part, t=s)
                 pending = -part
     elif settings.adaptive:
-        return _events_on_adaptive_steps(vessel, settings, y, events, names)
+        return _events_on_adaptive_steps(vessel, settings, y, events, names, callback)
     else:
         k, pending = 0, np.zeros(len(names))  # booked since the last row
         chunk = max(settings.save_every, 20_000 // settings.save_every * settings.save_every)
         done = False
         while k < n_steps and not done:
             kk = min(k + chunk, n_steps)
-            g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 1)
+            g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 1, from_step(k))
             b = _booked_steps(g, names)
             if k == 0:
                 rows.add(g, 0, b[0])
@@ -361,6 +367,8 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                 status, failure = g.status, g.failure
                 break
             y, k = g.last_good_state, kk
+            if callback is not None:
+                callback(k, n_steps)
     return _assemble(rows, names, status, failure, hits, steps, settings)
 
 
@@ -400,7 +408,7 @@ def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, 
     return t_a + hi, best, _booked_steps(best, names).sum(axis=0)
 
 
-def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names):
+def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names, callback=None):
     """Events on adaptive steps: the run is one core call to its end, saving every accepted
     step; a crossing between two accepted states is located as on the fixed grid, each trial a
     partial step from the accepted state before it taken as two halves, the accepted steps' own
@@ -410,7 +418,10 @@ def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names):
     from dataclasses import replace
 
     t0, t1 = settings.t_span
-    g = _call(vessel, replace(settings, save_every=1), t0, t1, settings.h, y, 1)
+    g = _call(vessel, replace(settings, save_every=1), t0, t1, settings.h, y, 1, callback)
+    if callback is not None and g.status == "completed":  # the core reports only every 0.1 s
+        n_steps = int(settings.checked()["n_steps"])
+        callback(n_steps, n_steps)
     fixed = replace(settings, rtol=None, atol=None, h_max=None)
     b = _booked_steps(g, names)
     pending = np.zeros(len(names))  # booked since the last row

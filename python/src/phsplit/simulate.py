@@ -181,27 +181,29 @@ def simulate(
         raise _core.InvalidInputError("running_max cannot be combined with save_at or events")
     if events is not None and not isinstance(events, (list, tuple)):
         events = [events]  # a single Event
-    if save_at is not None or events:
-        # Output at chosen times, or events: several core calls (phsplit.events).
-        if y0 is not None and not _continuing:
-            y0 = _core.check_state(y0, bool(orthonormalize))  # a user's state: checked once, here
-        return run_with_outputs(vessel, settings, y0, save_at=save_at, events=events)
+    if (save_at is not None or events) and y0 is not None and not _continuing:
+        y0 = _core.check_state(y0, bool(orthonormalize))  # a user's state: checked once, here
+    bars: list = []  # the progress bar, drawn from the first report on (not before an input error)
     if progress is True:
         from tqdm import tqdm
 
         n = settings.checked()["n_steps"]
-        bar = tqdm(total=n, unit="step", unit_scale=True, leave=False)
 
-        def cb(done, total, _bar=bar):
-            _bar.update(done - _bar.n)
+        def cb(done, total):
+            if not bars:
+                bars.append(tqdm(total=n, unit="step", unit_scale=True, leave=False))
+            bars[0].update(done - bars[0].n)
     elif progress is None or progress is False:
-        bar, cb = None, None
+        cb = None
     elif callable(progress):
-        bar, cb = None, progress
+        cb = progress
     else:
         raise _core.InvalidInputError(f"progress must be True, False, None or a callable f(steps_done, n_steps), "
                                       f"got {type(progress).__name__}")
     try:
+        if save_at is not None or events:
+            # Output at chosen times, or events: several core calls (phsplit.events).
+            return run_with_outputs(vessel, settings, y0, save_at=save_at, events=events, callback=cb)
         # _continuing: y0 is the last state of an earlier call of the same run, taken as it is.
         sol = run(vessel, settings, y0, orthonormalize=bool(orthonormalize), callback=cb,
                   running_max=bool(running_max), continuing=bool(_continuing), save_at=adaptive_at)
@@ -213,8 +215,8 @@ def simulate(
             return only_times(sol, adaptive_at, settings)
         return sol
     finally:
-        if bar is not None:
-            bar.close()
+        for b in bars:
+            b.close()
 
 
 _provided.provide("simulate", simulate)
