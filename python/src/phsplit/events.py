@@ -327,40 +327,25 @@ def run_with_outputs(vessel, settings, y0, save_at=None, events: Sequence[Event]
                 rows.add(p, -1, pending + part, t=s)
                 pending = -part
     elif settings.adaptive:
-        return _events_on_adaptive_steps(vessel, settings, y, events, names, callback)
+        return _events_on_adaptive_steps(vessel, settings, y, events, names, n_steps, callback)
     else:
         k, pending = 0, np.zeros(len(names))  # booked since the last row
         chunk = max(settings.save_every, 20_000 // settings.save_every * settings.save_every)
-        done = False
-        while k < n_steps and not done:
+        while k < n_steps:
             kk = min(k + chunk, n_steps)
             g = _call(vessel, settings, t_at(k), t_at(kk), h, y, 1, from_step(k))
             b = _booked_steps(g, names)
             if k == 0:
                 rows.add(g, 0, b[0])
-            for i in range(1, len(g.t)):
-                ya, yb = g.state(i - 1), g.state(i)
-                found = []
-                for ev in events:
-                    if ev.crosses(ev.value(float(g.t[i - 1]), ya, vessel), ev.value(float(g.t[i]), yb, vessel)):
-                        found.append((*_locate(vessel, settings, ev, float(g.t[i - 1]), ya,
-                                               float(g.t[i]) - float(g.t[i - 1]), names), ev))
-                found.sort(key=lambda f: f[0])
-                for te, part, w, ev in found:
-                    hits.append(EventHit(ev.name, te, part.state(-1), ev.terminal))
-                    if ev.terminal:
-                        rows.add(part, -1, pending + w, t=te)
-                        status, done = "event", True
-                        steps = k + i - 1
-                        break
-                if done:
-                    break
-                pending = pending + b[i]
-                step_index = k + i
-                if step_index % settings.save_every == 0 or step_index == n_steps or i == len(g.t) - 1 and g.status != "completed":
-                    rows.add(g, i, pending)
-                    pending = np.zeros(len(names))
-            if done:
+
+            def keep(i, k=k, g=g):
+                return (k + i) % settings.save_every == 0 or k + i == n_steps or (
+                    i == len(g.t) - 1 and g.status != "completed")
+
+            pending, ended = _watch(vessel, g, b, events, pieces=1, keep=keep, rows=rows, hits=hits,
+                                    pending=pending, names=names, settings=settings)
+            if ended is not None:
+                status, steps = "event", k + ended - 1
                 break
             steps = k + g.steps
             if g.status != "completed":
@@ -408,7 +393,7 @@ def _locate(vessel, settings, ev: Event, t_a: float, y_a: np.ndarray, h: float, 
     return t_a + hi, best, _booked_steps(best, names).sum(axis=0)
 
 
-def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names, callback=None):
+def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names, n_steps: int, callback=None):
     """Events on adaptive steps: the run is one core call to its end, saving every accepted
     step; a crossing between two accepted states is located as on the fixed grid, each trial a
     partial step from the accepted state before it taken as two halves, the accepted steps' own
@@ -420,33 +405,43 @@ def _events_on_adaptive_steps(vessel, settings, y, events: list[Event], names, c
     t0, t1 = settings.t_span
     g = _call(vessel, replace(settings, save_every=1), t0, t1, settings.h, y, 1, callback)
     if callback is not None and g.status == "completed":  # the core reports only every 0.1 s
-        n_steps = int(settings.checked()["n_steps"])
         callback(n_steps, n_steps)
-    fixed = replace(settings, rtol=None, atol=None, h_max=None)
     b = _booked_steps(g, names)
-    pending = np.zeros(len(names))  # booked since the last row
     rows, hits = _Rows(), []
-    status, failure, steps = g.status, g.failure, g.steps
     rows.add(g, 0, b[0])
-    t = np.asarray(g.t, dtype=float)
-    for i in range(1, len(t)):
+    _, ended = _watch(vessel, g, b, events, pieces=2,
+                      keep=lambda i: i % settings.save_every == 0 or i == len(g.t) - 1, rows=rows, hits=hits,
+                      pending=np.zeros(len(names)), names=names,
+                      settings=replace(settings, rtol=None, atol=None, h_max=None))
+    if ended is not None:
+        return _assemble(rows, names, "event", None, hits, ended - 1, settings)
+    return _assemble(rows, names, g.status, g.failure, hits, g.steps, settings)
+
+
+def _watch(vessel, g, b, events: list[Event], *, pieces: int, keep, rows: _Rows, hits: list, pending, names,
+           settings):
+    """Go through the steps of the core call ``g`` (``b``: each row's booking) watching
+    ``events``. A crossing within a step is located by :func:`_locate` (with fixed-step
+    ``settings``, each trial ``pieces`` steps) and recorded in ``hits``, in time order; a
+    terminal one adds its row and ends the watch. The rows where ``keep(i)`` are added with
+    what was booked since the row before (``pending`` on entry). Returns what is pending after
+    the last row, and the step ``i`` a terminal event ended in (None if none did)."""
+    for i in range(1, len(g.t)):
+        ta, tb = float(g.t[i - 1]), float(g.t[i])
         ya, yb = g.state(i - 1), g.state(i)
-        found = []
-        for ev in events:
-            if ev.crosses(ev.value(float(t[i - 1]), ya, vessel), ev.value(float(t[i]), yb, vessel)):
-                found.append((*_locate(vessel, fixed, ev, float(t[i - 1]), ya, float(t[i] - t[i - 1]), names,
-                                       pieces=2), ev))
+        found = [(*_locate(vessel, settings, ev, ta, ya, tb - ta, names, pieces), ev)
+                 for ev in events if ev.crosses(ev.value(ta, ya, vessel), ev.value(tb, yb, vessel))]
         found.sort(key=lambda f: f[0])
         for te, part, w, ev in found:
             hits.append(EventHit(ev.name, te, part.state(-1), ev.terminal))
             if ev.terminal:
                 rows.add(part, -1, pending + w, t=te)
-                return _assemble(rows, names, "event", None, hits, i - 1, settings)
+                return pending, i
         pending = pending + b[i]
-        if i % settings.save_every == 0 or i == len(t) - 1:
+        if keep(i):
             rows.add(g, i, pending)
             pending = np.zeros(len(names))
-    return _assemble(rows, names, status, failure, hits, steps, settings)
+    return pending, None
 
 
 def _assemble(rows: _Rows, names, status, failure, hits, steps, settings):
