@@ -91,8 +91,7 @@ fn flows(c: &mut Criterion) {
             let opts = thousand_steps(false);
             let label = match (&method, lf) {
                 (Method::RungeKutta(_), _) => format!("1000 steps: {name}"),
-                (_, LinearFlow::Exact) => format!("1000 steps: {name} (exact S2)"),
-                (_, LinearFlow::Gauss) => format!("1000 steps: {name} (gauss S2)"),
+                (_, lf) => format!("1000 steps: {name} ({} S2)", lf.name()),
             };
             c.bench_function(&label, |b| {
                 b.iter(|| run(&sys, &method, black_box(y0.clone()), &opts).unwrap())

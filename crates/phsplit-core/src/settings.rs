@@ -80,9 +80,9 @@ impl std::str::FromStr for FlowChoice {
     fn from_str(s: &str) -> Result<Self> {
         match s {
             "auto" => Ok(FlowChoice::Auto),
-            "exact" | "gauss" => Ok(FlowChoice::Named(s.parse()?)),
+            "exact" | "gauss" | "gauss4" | "gauss6" => Ok(FlowChoice::Named(s.parse()?)),
             other => Err(Error::InvalidInput(format!(
-                "linear_flow must be 'auto' (exact where it acts on a diagonal mass matrix, else Gauss), 'exact' (matrix exponential) or 'gauss' (Gauss collocation / diagonal Padé), got {other:?}"
+                "linear_flow must be 'auto' (exact where it acts on a diagonal mass matrix, else Gauss), 'exact' (matrix exponential), 'gauss' (Gauss collocation / diagonal Padé of the method's order), 'gauss4' or 'gauss6' (Gauss collocation of order 4 or 6 whatever the method), got {other:?}"
             ))),
         }
     }
@@ -128,7 +128,7 @@ pub const KEYS: [(&str, &str); 13] = [
     ),
     ("outer", "'dissipative' or 'conservative'"),
     ("save_every", "an integer >= 1"),
-    ("linear_flow", "'auto', 'exact' or 'gauss'"),
+    ("linear_flow", "'auto', 'exact', 'gauss', 'gauss4' or 'gauss6'"),
     ("ledger", "true or false"),
     ("project_invariants", "true or false"),
     ("rtol", "relative tolerance of adaptive steps, in (0, 1]"),

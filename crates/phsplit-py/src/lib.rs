@@ -420,7 +420,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("OUTER", methods::composition::OUTER_NAMES.to_vec())?;
     m.add(
         "LINEAR_FLOWS",
-        vec![LinearFlow::Exact.name(), LinearFlow::Gauss.name()],
+        LinearFlow::ALL.map(LinearFlow::name).to_vec(),
     )?;
     m.add("MAX_STEPS", phsplit_core::solve::MAX_STEPS)?;
     m.add("STATE_DIM", STATE_DIM)?;

@@ -31,7 +31,7 @@ settings and the vessel, and names a key nobody reads, with the nearest valid on
     control_start = 50.0    # s, or "never"
     outer = "dissipative"   # or "conservative"
     save_every = 1
-    linear_flow = "auto"    # the default, or "exact" (the paper's), or "gauss"
+    linear_flow = "auto"    # the default, or "exact" (the paper's), "gauss", "gauss4", "gauss6"
 
     [external]              # a constant load at a point of the hull
     force = [2.0e5, 0.0, 0.0]   # N

@@ -43,6 +43,15 @@ pub enum LinearFlow {
     /// and still energy-dissipative on S2, so the passivity of the composition is kept (paper
     /// Remark 2.3). The ledger stays exact (Gauss quadrature of a quadratic storage).
     Gauss,
+    /// Gauss collocation with two stages (order 4) whatever the composition's order (at least
+    /// its `⌈order/2⌉`): S2 more accurate than the composition needs. Where the error of a
+    /// second-order method comes mostly from S2 (a sea's forcing, or the linear damping and
+    /// controller, which the one-stage midpoint rule follows to second order), this removes
+    /// most of it for about 1.6 times the cost of a step (docs/how-to/choose-method-step-flow.md).
+    /// Passive as [`LinearFlow::Gauss`] (Gauss collocation is algebraically stable, any stages).
+    Gauss4,
+    /// Gauss collocation with three stages (order 6) whatever the composition's order.
+    Gauss6,
 }
 
 impl std::str::FromStr for LinearFlow {
@@ -51,18 +60,51 @@ impl std::str::FromStr for LinearFlow {
         match s {
             "exact" => Ok(LinearFlow::Exact),
             "gauss" => Ok(LinearFlow::Gauss),
+            "gauss4" => Ok(LinearFlow::Gauss4),
+            "gauss6" => Ok(LinearFlow::Gauss6),
             other => Err(Error::InvalidInput(format!(
-                "linear_flow must be 'exact' (matrix exponential) or 'gauss' (Gauss collocation / diagonal Padé), got {other:?}"
+                "linear_flow must be 'exact' (matrix exponential), 'gauss' (Gauss collocation / diagonal Padé of the method's order), 'gauss4' or 'gauss6' (Gauss collocation of order 4 or 6 whatever the method), got {other:?}"
             ))),
         }
     }
 }
 
 impl LinearFlow {
+    /// Every flow, by name.
+    pub const ALL: [LinearFlow; 4] = [
+        LinearFlow::Exact,
+        LinearFlow::Gauss,
+        LinearFlow::Gauss4,
+        LinearFlow::Gauss6,
+    ];
     pub fn name(self) -> &'static str {
         match self {
             LinearFlow::Exact => "exact",
             LinearFlow::Gauss => "gauss",
+            LinearFlow::Gauss4 => "gauss4",
+            LinearFlow::Gauss6 => "gauss6",
+        }
+    }
+    /// Whether S2 is collocated (any of the Gauss flows).
+    pub fn is_gauss(self) -> bool {
+        self != LinearFlow::Exact
+    }
+    /// The Gauss stages of S2 for a composition of `order` (those of [`LinearFlow::Gauss`] where
+    /// S2 is collocated for want of the exact flow).
+    pub fn stages(self, order: usize) -> usize {
+        let of_order = order.div_ceil(2).max(1);
+        match self {
+            LinearFlow::Exact | LinearFlow::Gauss => of_order,
+            LinearFlow::Gauss4 => of_order.max(2),
+            LinearFlow::Gauss6 => of_order.max(3),
+        }
+    }
+    /// The order S2 is integrated to, where it is fixed whatever the method.
+    pub fn fixed_order(self) -> Option<usize> {
+        match self {
+            LinearFlow::Gauss4 => Some(4),
+            LinearFlow::Gauss6 => Some(6),
+            LinearFlow::Exact | LinearFlow::Gauss => None,
         }
     }
 }
@@ -207,9 +249,10 @@ impl<'a> VesselSystem<'a> {
     }
 
     /// How flow S2 is integrated in this system: the chosen [`LinearFlow`], or Gauss
-    /// collocation when S2 has a forcing part.
+    /// collocation of the method's order when S2 has a forcing part and the exact flow was
+    /// chosen.
     pub fn s2_solver(&self) -> LinearFlow {
-        if self.forced {
+        if self.forced && self.linear == LinearFlow::Exact {
             LinearFlow::Gauss
         } else {
             self.linear
@@ -1088,6 +1131,31 @@ mod tests {
         }
     }
 
+    /// `gauss4` and `gauss6` collocate S2 with at least the composition's stages, and refuse a
+    /// composition of a higher order than theirs (it would lose its order).
+    #[test]
+    fn a_fixed_order_s2_takes_at_least_the_methods_stages() {
+        use crate::solve::SplitModel;
+        for (lf, want) in [
+            (LinearFlow::Gauss, [1, 1, 2, 3]),
+            (LinearFlow::Gauss4, [2, 2, 2, 3]),
+            (LinearFlow::Gauss6, [3, 3, 3, 3]),
+        ] {
+            let got = [1, 2, 4, 6].map(|order| lf.stages(order));
+            assert_eq!(got, want, "{}", lf.name());
+        }
+        let v = Vessel::paper();
+        let sys = VesselSystem::new(&v, Some(0.0)).with_linear_flow(LinearFlow::Gauss4);
+        assert!(sys.supports_order(4).is_ok());
+        let e = sys.supports_order(6).unwrap_err().to_string();
+        assert!(e.contains("gauss4") && e.contains("order 6"), "{e}");
+        let sys = VesselSystem::new(&v, Some(0.0)).with_linear_flow(LinearFlow::Gauss6);
+        assert!(sys.supports_order(6).is_ok());
+        for lf in LinearFlow::ALL {
+            assert_eq!(lf.name().parse::<LinearFlow>().unwrap(), lf);
+        }
+    }
+
     /// The coupled flow S2 (one 18-dimensional system) where nothing couples is the block
     /// systems' flow: the paper's vessel through both paths, exact and Gauss with 1–3 stages,
     /// the flow and every account to round-off.
@@ -1112,7 +1180,7 @@ mod tests {
                 let z0 = sys.blocks_of(&s0);
                 let (za, wa) = match lf {
                     LinearFlow::Exact => sys.exact_s2(&b, &z0, h, true),
-                    LinearFlow::Gauss => sys.gauss_s2(&b, &z0, h, stages),
+                    _ => sys.gauss_s2(&b, &z0, h, stages),
                 };
                 b.cross = Some([[Matrix3::zeros(); 3]; 2]);
                 let (zb, wb) = sys.coupled_s2(&fr, &b, &z0, h, 0.0, stages);

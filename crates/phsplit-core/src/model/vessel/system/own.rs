@@ -9,7 +9,7 @@
 //! Gramian `∫ w wᵀ dt` over the sub-step by Van Loan's block exponential (C. F. Van Loan, IEEE
 //! Trans. Autom. Control 23 (1978) 395–404): every account's energy is a quadratic form in
 //! `w`, so its integral is exact along the flow. Gauss collocation (with a forcing part,
-//! iterated to a fixed point; or with [`LinearFlow::Gauss`]) solves the dense stage system
+//! iterated to a fixed point; or with [`LinearFlow::Gauss`](super::LinearFlow::Gauss)) solves the dense stage system
 //! once per sub-step and books each account's power at the stages with the Gauss weights,
 //! exact for the collocation polynomial of a quadratic storage (Hairer, Lubich, Wanner,
 //! *Geometric Numerical Integration*, §IV.2). Both are energy-dissipative for a dissipative S2,
@@ -18,7 +18,7 @@
 use super::super::forces::{Frozen, OwnLinear, S2Builder};
 use super::super::state::VesselState;
 use super::s2::augmented;
-use super::{GaveUp, LinearFlow, VesselSystem};
+use super::{GaveUp, VesselSystem};
 use crate::flows::collocation::Z3;
 use crate::solve::Work;
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -159,7 +159,7 @@ impl VesselSystem<'_> {
         let w0 = self.pack(&z0, &s.own);
         let (w1, work) = self.with_s2(s, on, ledger, false, |fr, b| {
             let a = self.dense(fr, b);
-            if self.forced || self.linear == LinearFlow::Gauss {
+            if self.forced || self.linear.is_gauss() {
                 self.dense_collocation(fr, b, &a, &w0, h, t, stages)
             } else {
                 self.dense_exact(fr, b, &a, &w0, h)

@@ -51,8 +51,8 @@ impl VesselSystem<'_> {
                 self.coupled_s2(fr, b, &z0, h, t, stages)
             } else {
                 match self.linear {
-                    LinearFlow::Gauss => self.gauss_s2(b, &z0, h, stages),
                     LinearFlow::Exact => self.exact_s2(b, &z0, h, fr.control_on),
+                    _ => self.gauss_s2(b, &z0, h, stages),
                 }
             }
         });

@@ -31,6 +31,12 @@ impl SplitModel for VesselSystem<'_> {
                 "the method (simulation.method, method=) is a composition of order {order}, which needs sub-flows of order {order}; the lumped-mass pipe's flow is nested in flow S2 by Strang's rule, of order 2: use lie or sp2 (or pipe.model = \"catenary\")"
             )));
         }
+        if let Some(fixed) = self.linear.fixed_order().filter(|&o| o < order) {
+            return Err(Error::InvalidInput(format!(
+                "linear_flow = '{}' integrates flow S2 to order {fixed}, below the method's order {order} (simulation.method, method=), which would lose its order: take linear_flow = 'gauss' (the method's order), 'gauss6' or 'auto'",
+                self.linear.name()
+            )));
+        }
         if order > MAX_SUBFLOW_ORDER {
             return Err(Error::InvalidInput(format!(
                 "the method (simulation.method, method=) is a composition of order {order}, which needs sub-flows of order {order}; the vessel's flows provide order {MAX_SUBFLOW_ORDER} at most (Magnus 6, Gauss collocation with 3 stages)"
@@ -55,7 +61,7 @@ impl SplitModel for VesselSystem<'_> {
                 Work::default()
             }
             Flow::S2 => {
-                let stages = order.div_ceil(2).max(1);
+                let stages = self.linear.stages(order);
                 let on = self.control_on(t_step);
                 if self.own_flowing.is_empty() {
                     return self.flow_s2(s, h, t, on, ledger, stages);
