@@ -51,8 +51,8 @@ def test_the_vessel_fmu_has_a_parameter_for_every_step_setting():
 def test_the_default_flow_s2_is_chosen_by_the_vessel():
     """``linear_flow = "auto"`` (the default): the exact S2 on the paper's vessel at fixed steps,
     Gauss with adaptive steps, with a general mass matrix, with a forcing, or with component
-    states; the result says which ran,
-    and a named flow is taken as named."""
+    states; with a forcing and a second-order splitting at fixed steps, Gauss of order 4; the
+    result says which ran, and a named flow is taken as named."""
     def ran(v, **kw):
         return phsplit.simulate(v, (0.0, 2.0), 0.5, "sp2", **kw).meta["s2_solver"]
 
@@ -60,11 +60,15 @@ def test_the_default_flow_s2_is_chosen_by_the_vessel():
     paper = phsplit.Vessel.paper()
     assert ran(paper) == "exact" and ran(paper, linear_flow="gauss") == "gauss"
     assert ran(paper, atol=1e-3) == "gauss" and ran(paper, atol=1e-3, linear_flow="exact") == "exact"
-    assert ran(phsplit.Vessel.preset("osv")) == "gauss"  # general M (and cross-flow drag)
+    osv = phsplit.Vessel.preset("osv")
+    assert ran(osv) == "gauss4"  # general M and cross-flow drag, a forcing: order 4 for sp2
+    assert ran(osv, atol=1e-3) == "gauss"  # adaptive steps: the method's order
+    assert phsplit.simulate(osv, (0.0, 2.0), 0.5, "sp4").meta["s2_solver"] == "gauss"  # order 4 already
+    assert phsplit.simulate(osv, (0.0, 2.0), 0.5, "lie").meta["s2_solver"] == "gauss"  # order 1
     d = paper.to_dict()
     d["current"] = {"velocity": [0.3, 0.0, 0.0]}
     assert ran(phsplit.Vessel.from_dict(d)) == "exact"  # a steady current: affine, exact acts
     d["current"] = {"times": [0.0, 100.0], "velocities": [[0.0, 0.0, 0.0], [0.3, 0.0, 0.0]]}
-    assert ran(phsplit.Vessel.from_dict(d)) == "gauss"  # a forcing in time
+    assert ran(phsplit.Vessel.from_dict(d)) == "gauss4"  # a forcing in time
     tank = phsplit.scenario.load(phsplit.scenario.resolve("anti-roll-tank")).vessel
     assert ran(tank) == "gauss"  # a subsystem's own states

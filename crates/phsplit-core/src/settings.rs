@@ -64,12 +64,16 @@ impl Default for Settings {
 pub enum FlowChoice {
     /// The exact S2 where it acts (no forcing part: docs/model.md §3.7) on a vessel whose mass
     /// matrix has the paper's diagonal form and whose components keep no states of their own
-    /// (their exact flow is the dense system's, several times a collocated step); Gauss
-    /// collocation otherwise. Measured
+    /// (their exact flow is the dense system's, several times a collocated step); with a
+    /// forcing part and a second-order method at fixed steps, Gauss collocation of order 4
+    /// ([`LinearFlow::Gauss4`]); Gauss collocation of the method's order otherwise. Measured
     /// (`benchmarks/energy_accuracy.py`, `benchmarks/workloads.py`): on the paper's vessel the
     /// exact S2 reached the energy accuracies of Fig. 4 sooner (SP2 reached 1e-3 only with it)
     /// and the workloads' 1 cm sooner at fixed steps; with a general mass matrix the exact
-    /// coupled S2 costs several times a collocated step (docs/performance.md).
+    /// coupled S2 costs several times a collocated step (docs/performance.md); with a forcing,
+    /// SP2's error at fixed steps came mostly from its one-stage S2, and two stages reached
+    /// 1 cm over `dp-weather`'s hour at four times the step, in 0.58 of the time, and the OSV's
+    /// in a current at twice the step (docs/how-to/choose-method-step-flow.md).
     Auto,
     /// The flow named.
     Named(LinearFlow),
@@ -95,11 +99,13 @@ impl FlowChoice {
             FlowChoice::Named(f) => f.name(),
         }
     }
-    /// The flow S2 a run of `vessel` takes, with fixed or `adaptive` steps. Adaptive steps
-    /// take Gauss: each step has its own length, so the exact flow's exponentials are not
-    /// reused from step to step (`benchmarks/workloads.py`: the paper's hour to 1 cm by SP2
-    /// adaptive took about three times as long with the exact S2).
-    pub fn for_vessel(self, vessel: &Vessel, adaptive: bool) -> LinearFlow {
+    /// The flow S2 a run of `vessel` takes, with fixed or `adaptive` steps, by `method`.
+    /// Adaptive steps take Gauss of the method's order: each step has its own length, so the
+    /// exact flow's exponentials are not reused from step to step
+    /// (`benchmarks/workloads.py`: the paper's hour to 1 cm by SP2 adaptive took about three
+    /// times as long with the exact S2), and the OSV's hour to 1 cm by SP2 adaptive took 1.6
+    /// times as long with two Gauss stages.
+    pub fn for_vessel(self, vessel: &Vessel, adaptive: bool, method: &Method) -> LinearFlow {
         match self {
             FlowChoice::Named(f) => f,
             FlowChoice::Auto if adaptive => LinearFlow::Gauss,
@@ -109,6 +115,8 @@ impl FlowChoice {
                 let own = vessel.own_layout().next().is_some();
                 if !forced && vessel.body.is_diagonal() && !own {
                     LinearFlow::Exact
+                } else if forced && !own && matches!(method, Method::Splitting(c) if c.order == 2) {
+                    LinearFlow::Gauss4
                 } else {
                     LinearFlow::Gauss
                 }
@@ -128,7 +136,10 @@ pub const KEYS: [(&str, &str); 13] = [
     ),
     ("outer", "'dissipative' or 'conservative'"),
     ("save_every", "an integer >= 1"),
-    ("linear_flow", "'auto', 'exact', 'gauss', 'gauss4' or 'gauss6'"),
+    (
+        "linear_flow",
+        "'auto', 'exact', 'gauss', 'gauss4' or 'gauss6'",
+    ),
     ("ledger", "true or false"),
     ("project_invariants", "true or false"),
     ("rtol", "relative tolerance of adaptive steps, in (0, 1]"),

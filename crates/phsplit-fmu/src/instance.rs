@@ -406,7 +406,11 @@ impl Instance {
             ));
         }
         let sys = VesselSystem::new(&r.vessel, r.settings.control_start)
-            .with_linear_flow(r.settings.linear_flow.for_vessel(&r.vessel, false))
+            .with_linear_flow(r.settings.linear_flow.for_vessel(
+                &r.vessel,
+                false,
+                &r.settings.method,
+            ))
             .with_projection(r.settings.project_invariants);
         let traj =
             run(&sys, &r.settings.method, r.state.clone(), &opts).map_err(|e| e.to_string())?;

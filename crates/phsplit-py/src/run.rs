@@ -109,7 +109,7 @@ fn integrate<'py>(
         .detach(move || {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 let sys = VesselSystem::new(&v, s2.control_start)
-                    .with_linear_flow(s2.linear_flow.for_vessel(&v, s2.adaptive()))
+                    .with_linear_flow(s2.linear_flow.for_vessel(&v, s2.adaptive(), &s2.method))
                     .with_projection(s2.project_invariants)
                     .with_extrema(extrema);
                 let traj = run_watched(&sys, &s2.method, y0, &opts, mon)?;

@@ -22,7 +22,8 @@ _OPTIONAL = ("rtol", "atol", "h_max")
 class Settings:
     """The settings of a run, with the one set of defaults (the core's; the paper's Fig. 2:
     SP4, h = 0.5 s on [0, 200] s, the controller from t = 50 s; flow S2 ``"auto"``: exact where
-    it acts on a diagonal mass matrix, else Gauss collocation; ``linear_flow = "exact"`` for the
+    it acts on a diagonal mass matrix, else Gauss collocation, of order 4 for a second-order
+    method at fixed steps where S2 has a forcing part; ``linear_flow = "exact"`` for the
     paper's exact S2) shared by :func:`simulate`,
     scenario files, :func:`~phsplit.simulate_many` and sweeps. Values are checked by the core
     when a run starts (or by :meth:`checked`)."""

@@ -102,8 +102,9 @@ def simulate(
     or three stages, still passive; in a sea, ``sp2`` with ``"gauss4"`` reaches 1 cm over an
     hour at about four times the step of ``"gauss"``, docs/how-to, "The linear flow S2");
     ``"auto"``, the default, takes the exact flow with fixed steps where
-    it acts on a vessel with the paper's diagonal mass matrix and no component states, Gauss
-    elsewhere and with adaptive steps (measured: docs/how-to,
+    it acts on a vessel with the paper's diagonal mass matrix and no component states,
+    ``"gauss4"`` with fixed steps of ``sp2`` or ``mcl2`` where S2 has a forcing part (and no
+    component states), Gauss elsewhere and with adaptive steps (measured: docs/how-to,
     "The linear flow S2"); ``Solution.meta["s2_solver"]`` says which ran. An initial
     attitude that is not a rotation is rejected unless ``orthonormalize=True`` asks for its
     projection to the nearest rotation. ``settings`` (a :class:`Settings`) gives all the
