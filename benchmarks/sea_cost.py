@@ -9,6 +9,8 @@ valgrind's callgrind (deterministic: the difference between runs of ``--steps`` 
 
     cargo build --release -p phsplit-core --example sea_steps
     .venv/bin/python benchmarks/sea_cost.py [--out benchmarks/results/sea_cost.md]
+
+The sea's run is also measured with S2 by two Gauss stages (``linear_flow = "gauss4"``).
 """
 from __future__ import annotations
 
@@ -47,10 +49,10 @@ def vessel_files(d: str) -> dict[str, str]:
     return out
 
 
-def instructions(exe: str, path: str, steps: int, d: str) -> int:
+def instructions(exe: str, path: str, steps: int, d: str, flow: list[str]) -> int:
     """Instructions callgrind counts for a run of ``steps`` steps (setup included)."""
-    f = os.path.join(d, f"cg.{os.path.basename(path)}.{steps}")
-    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={f}", exe, path, "0.5", str(steps)],
+    f = os.path.join(d, f"cg.{os.path.basename(path)}.{steps}.{''.join(flow)}")
+    subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={f}", exe, path, "0.5", str(steps), *flow],
                    check=True, capture_output=True)
     with open(f) as fh:
         for line in fh:
@@ -59,9 +61,9 @@ def instructions(exe: str, path: str, steps: int, d: str) -> int:
     sys.exit(f"no summary in {f}")
 
 
-def wall(exe: str, path: str, steps: int) -> float:
+def wall(exe: str, path: str, steps: int, flow: list[str]) -> float:
     """Microseconds per step the example reports."""
-    p = subprocess.run([exe, path, "0.5", str(steps)], check=True, capture_output=True, text=True)
+    p = subprocess.run([exe, path, "0.5", str(steps), *flow], check=True, capture_output=True, text=True)
     return float(re.search(r": ([0-9.]+) us per step", p.stdout)[1])
 
 
@@ -77,14 +79,19 @@ def main() -> None:
         sys.exit("valgrind is needed for the instruction counts")
     with tempfile.TemporaryDirectory() as d:
         files = vessel_files(d)
+        # (file, flow S2): each with the core's flow (exact where it acts, else Gauss of the
+        # method's order, one stage for SP2), and the sea with two stages (linear_flow "gauss4",
+        # what "auto" takes for SP2 at fixed steps in a sea).
+        runs = {name: (p, []) for name, p in files.items()}
+        runs["weather_gauss4"] = (files["weather"], ["gauss4"])
         per_step = {}
-        for name, p in files.items():
+        for name, (p, flow) in runs.items():
             n1, n2 = args.steps // 2, args.steps
-            per_step[name] = (instructions(args.exe, p, n2, d) - instructions(args.exe, p, n1, d)) / (n2 - n1)
-        times: dict[str, list[float]] = {k: [] for k in files}
+            per_step[name] = (instructions(args.exe, p, n2, d, flow) - instructions(args.exe, p, n1, d, flow)) / (n2 - n1)
+        times: dict[str, list[float]] = {k: [] for k in runs}
         for _ in range(args.rounds):
-            for name, p in files.items():
-                times[name].append(wall(args.exe, p, args.wall_steps))
+            for name, (p, flow) in runs.items():
+                times[name].append(wall(args.exe, p, args.wall_steps, flow))
     med = {k: statistics.median(v) for k, v in times.items()}
     text = (
         f"Measured {datetime.datetime.now(datetime.timezone.utc).strftime('%Y-%m-%d %H:%M UTC')} on "
@@ -93,18 +100,21 @@ def main() -> None:
         "One SP2 step (h = 0.5 s, ledger, controller on) of the paper's vessel in dp-weather's sea "
         "(150 wave components with drift, 100 gust components, current) and in calm water "
         "(the same vessel file without [waves] and [wind]); "
-        "mean wind only: the same vessel with the wind's mean load but no gusts and no waves.\n\n"
-        "| | calm | mean wind only | dp-weather | dp-weather / calm | mean wind / calm |\n"
-        "|---|---|---|---|---|---|\n"
+        "mean wind only: the same vessel with the wind's mean load but no gusts and no waves. "
+        "Flow S2: exact in calm water, Gauss of the method's order (one stage) with a forcing; "
+        "dp-weather (gauss4): two stages, what linear_flow = \"auto\" takes for SP2 at fixed steps in a sea.\n\n"
+        "| | calm | mean wind only | dp-weather | dp-weather (gauss4) | dp-weather / calm | mean wind / calm |\n"
+        "|---|---|---|---|---|---|---|\n"
         f"| instructions per step (callgrind, {args.steps // 2} steps' difference) | {per_step['calm']:.0f} | "
-        f"{per_step['mean_wind']:.0f} | {per_step['weather']:.0f} | {per_step['weather'] / per_step['calm']:.2f} | "
-        f"{per_step['mean_wind'] / per_step['calm']:.2f} |\n"
+        f"{per_step['mean_wind']:.0f} | {per_step['weather']:.0f} | {per_step['weather_gauss4']:.0f} | "
+        f"{per_step['weather'] / per_step['calm']:.2f} | {per_step['mean_wind'] / per_step['calm']:.2f} |\n"
         f"| wall clock per step (µs, median of {args.rounds} alternating runs of {args.wall_steps} steps) | "
-        f"{med['calm']:.2f} | {med['mean_wind']:.2f} | {med['weather']:.2f} | {med['weather'] / med['calm']:.2f} | "
-        f"{med['mean_wind'] / med['calm']:.2f} |\n"
+        f"{med['calm']:.2f} | {med['mean_wind']:.2f} | {med['weather']:.2f} | {med['weather_gauss4']:.2f} | "
+        f"{med['weather'] / med['calm']:.2f} | {med['mean_wind'] / med['calm']:.2f} |\n"
         f"\nWall-clock runs (µs per step): calm {', '.join(f'{x:.2f}' for x in times['calm'])}; "
         f"mean wind {', '.join(f'{x:.2f}' for x in times['mean_wind'])}; "
-        f"dp-weather {', '.join(f'{x:.2f}' for x in times['weather'])}.\n"
+        f"dp-weather {', '.join(f'{x:.2f}' for x in times['weather'])}; "
+        f"dp-weather (gauss4) {', '.join(f'{x:.2f}' for x in times['weather_gauss4'])}.\n"
     )
     print(text)
     if args.out:

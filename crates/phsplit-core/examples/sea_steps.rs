@@ -1,9 +1,11 @@
 //! SP2 steps of a vessel read from a vessel file (the TOML `phsplit.Vessel.to_toml` writes), with
 //! the ledger and the controller on: for comparing a step's cost in a sea with the same step in
 //! calm water (`benchmarks/sea_cost.py` writes both files and counts their instructions). Run:
-//! `cargo run --release -p phsplit-core --example sea_steps -- vessel.toml 0.5 200`.
+//! `cargo run --release -p phsplit-core --example sea_steps -- vessel.toml 0.5 200 [linear_flow]`
+//! (`linear_flow`: the core's default, `"exact"` where it acts and Gauss of the method's order
+//! where S2 has a forcing part, unless named).
 use phsplit_core::methods::{Method, Outer};
-use phsplit_core::model::vessel::{Vessel, VesselSystem};
+use phsplit_core::model::vessel::{LinearFlow, Vessel, VesselSystem};
 use phsplit_core::solve::{run, Options};
 use std::hint::black_box;
 
@@ -18,7 +20,10 @@ fn main() {
     let vessel = Vessel::from_toml_str(&text).expect("a valid vessel file");
     let y0 = vessel.initial_state();
     let method: Method = "sp2".parse().unwrap();
-    let sys = VesselSystem::new(&vessel, Some(0.0));
+    let mut sys = VesselSystem::new(&vessel, Some(0.0));
+    if let Some(lf) = args.get(4) {
+        sys = sys.with_linear_flow(lf.parse::<LinearFlow>().expect("a linear flow"));
+    }
     let opts = Options {
         t0: 0.0,
         h,
