@@ -82,13 +82,15 @@ pub enum FlowChoice {
 impl std::str::FromStr for FlowChoice {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        match s {
-            "auto" => Ok(FlowChoice::Auto),
-            "exact" | "gauss" | "gauss4" | "gauss6" => Ok(FlowChoice::Named(s.parse()?)),
-            other => Err(Error::InvalidInput(format!(
-                "linear_flow must be 'auto' (exact where it acts on a diagonal mass matrix, else Gauss), 'exact' (matrix exponential), 'gauss' (Gauss collocation / diagonal Padé of the method's order), 'gauss4' or 'gauss6' (Gauss collocation of order 4 or 6 whatever the method), got {other:?}"
-            ))),
+        if s == "auto" {
+            return Ok(FlowChoice::Auto);
         }
+        s.parse().map(FlowChoice::Named).map_err(|_| {
+            Error::InvalidInput(format!(
+                "linear_flow must be 'auto' (exact where it acts on a diagonal mass matrix, else Gauss), {}, got {s:?}",
+                LinearFlow::CHOICES
+            ))
+        })
     }
 }
 

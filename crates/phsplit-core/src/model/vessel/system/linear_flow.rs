@@ -28,15 +28,15 @@ pub enum LinearFlow {
 impl std::str::FromStr for LinearFlow {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        match s {
-            "exact" => Ok(LinearFlow::Exact),
-            "gauss" => Ok(LinearFlow::Gauss),
-            "gauss4" => Ok(LinearFlow::Gauss4),
-            "gauss6" => Ok(LinearFlow::Gauss6),
-            other => Err(Error::InvalidInput(format!(
-                "linear_flow must be 'exact' (matrix exponential), 'gauss' (Gauss collocation / diagonal Padé of the method's order), 'gauss4' or 'gauss6' (Gauss collocation of order 4 or 6 whatever the method), got {other:?}"
-            ))),
-        }
+        LinearFlow::ALL
+            .into_iter()
+            .find(|f| f.name() == s)
+            .ok_or_else(|| {
+                Error::InvalidInput(format!(
+                    "linear_flow must be {}, got {s:?}",
+                    LinearFlow::CHOICES
+                ))
+            })
     }
 }
 
@@ -48,6 +48,8 @@ impl LinearFlow {
         LinearFlow::Gauss4,
         LinearFlow::Gauss6,
     ];
+    /// The flows by name, with what each does, for messages.
+    pub const CHOICES: &'static str = "'exact' (matrix exponential), 'gauss' (Gauss collocation / diagonal Padé of the method's order), 'gauss4' or 'gauss6' (Gauss collocation of order 4 or 6 whatever the method)";
     pub fn name(self) -> &'static str {
         match self {
             LinearFlow::Exact => "exact",
