@@ -79,6 +79,8 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _parser() -> argparse.ArgumentParser:
+    from . import _core
+
     p = _Parser(
         prog="phsplit",
         description="Passivity-preserving splitting simulation of a vessel under DP control.",
@@ -107,7 +109,7 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument("--t-end", type=float, help="override the end time, s")
     s.add_argument("--save-every", type=int, help="save every k-th step (decimation)")
     s.add_argument("--control-start", help="override the controller's start time, s, or 'never'")
-    s.add_argument("--linear-flow", choices=["auto", "exact", "gauss", "gauss4", "gauss6"],
+    s.add_argument("--linear-flow", choices=["auto", *_core.LINEAR_FLOWS],
                    help="flow S2: 'auto' (the library's default: exact where it acts on a diagonal mass "
                    "matrix, else Gauss collocation), exactly (matrix exponentials, the paper's; the default "
                    "of the Fig. 2 scenario), by Gauss collocation of the method's order, or of order 4 or 6 "
