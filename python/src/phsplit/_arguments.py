@@ -32,18 +32,44 @@ def explain(name: str, sig: inspect.Signature, args: tuple, kw: dict, error: Typ
     return f"{name}(): {error}; {takes}"
 
 
+def _binds(sig: inspect.Signature) -> Callable[[tuple, dict], bool]:
+    """A quick test that a call's arguments bind to ``sig``, for the common calls: True only
+    where ``sig.bind`` would succeed (a call it cannot vouch for, ``False``, is bound by
+    ``sig.bind``, which then names what is wrong). It spares each call ``inspect``'s binding
+    (tens of microseconds, a share of a short run's time)."""
+    P = inspect.Parameter
+    ps = list(sig.parameters.values())
+    if any(p.kind in (P.VAR_POSITIONAL, P.VAR_KEYWORD, P.POSITIONAL_ONLY) for p in ps):
+        return lambda args, kw: False
+    positional = [p.name for p in ps if p.kind == P.POSITIONAL_OR_KEYWORD]
+    names = frozenset(p.name for p in ps)
+    required = [(i, p.name) for i, p in enumerate(ps) if p.default is P.empty]
+
+    def binds(args: tuple, kw: dict) -> bool:
+        n = len(args)
+        if n > len(positional) or not names.issuperset(kw):
+            return False
+        if any(k in kw for k in positional[:n]):
+            return False  # one argument given twice
+        return all(i < n or k in kw for i, k in required)
+
+    return binds
+
+
 def checked(f: F, name: str | None = None) -> F:
     """``f`` with its call's arguments bound to its signature first (see the module's text);
     ``name``: how the messages call it (default its qualified name)."""
     sig = inspect.signature(f)
     name = name or f.__qualname__
+    binds = _binds(sig)
 
     @functools.wraps(f)
     def call(*args: Any, **kw: Any) -> Any:
-        try:
-            sig.bind(*args, **kw)
-        except TypeError as e:
-            raise _core.InvalidInputError(explain(name, sig, args, kw, e)) from None
+        if not binds(args, kw):
+            try:
+                sig.bind(*args, **kw)
+            except TypeError as e:
+                raise _core.InvalidInputError(explain(name, sig, args, kw, e)) from None
         return f(*args, **kw)
 
     return call  # type: ignore[return-value]

@@ -94,9 +94,6 @@ pub fn run_splitting_adaptive<M: SplitModel>(
             hn = to - t;
         }
         let last = clipped && to == t1;
-        whole.clone_from(&y);
-        // The whole step is only compared: its ledger is not needed.
-        one_step(model, &subs, method.order, false, hn, t, &mut whole);
         halves.clone_from(&y);
         let mut w = one_step(
             model,
@@ -131,6 +128,11 @@ pub fn run_splitting_adaptive<M: SplitModel>(
                 &mut halves,
             );
         }
+        // The whole step after the halves: it is only compared (its ledger is not needed), and
+        // its first sub-step can take the first half's assembly at the same start, made with
+        // the ledger's rows (`model/vessel/system/memo.rs`).
+        whole.clone_from(&y);
+        one_step(model, &subs, method.order, false, hn, t, &mut whole);
         let err = if finite_half && model.is_finite(&halves) && model.is_finite(&whole) {
             model
                 .error_norm(&halves, &whole, &y, tol.rtol, tol.atol)

@@ -1,4 +1,5 @@
-//! The last frozen view and flow S2 assembled, kept for the next sub-step that needs the same.
+//! The last few frozen views and flows S2 assembled, kept for the next sub-steps that need the
+//! same.
 //!
 //! Flow S2's assembly (the frozen view's Euler angles, every component's rows, each account's
 //! booked rows) depends on the state only through the attitude `Q` and whether the controller
@@ -23,6 +24,11 @@
 //!   invariant (docs/model.md §3.6) leaves `Q` alone: without the projection, and with it
 //!   wherever its turn is below its floor (4ε: most steps of a long run once the transient has
 //!   passed). Sub-steps separated by S1 never share one.
+//! - Adaptive steps (`solve/adaptive.rs`): the whole step and its first half both begin with S2
+//!   at the step's start, and an output inside the step is one step from the step's start or
+//!   from the end of its first half, where an assembly was made moments before. Each such
+//!   assembly is still kept when it is asked again ([`KEPT`] of them, the least recently served
+//!   replaced).
 use super::super::forces::{Frozen, S2Builder};
 use super::super::state::{Actuators, VesselState};
 use super::VesselSystem;
@@ -82,21 +88,38 @@ struct Entry<'a> {
     /// Made by the probe, and since then reused by a sub-step.
     by_probe: bool,
     reused: bool,
+    /// When it was last served ([`Kept::clock`]): the least recently served is replaced.
+    served: u64,
 }
+
+/// How many assemblies are kept. An adaptive step assembles S2 at its start twice (the whole
+/// step and its first half, `solve/adaptive.rs`), and an output inside the step starts from the
+/// step's start or the end of its first half: four keep each of those until it is asked again.
+const KEPT: usize = 4;
 
 struct Kept<'a> {
-    entry: Option<Entry<'a>>,
+    entries: Vec<Entry<'a>>,
+    clock: u64,
+    /// How many sub-steps were served a kept assembly.
+    hits: u64,
 }
 
-/// The kept assembly of one vessel system. A system shared by threads that step at once keeps
-/// it for one of them; the others assemble as if there were none. Beside it, whether the
+/// The kept assemblies of one vessel system. A system shared by threads that step at once keeps
+/// them for one of them; the others assemble as if there were none. Beside them, whether the
 /// probe's whole assembly is taken by the next sub-step (until one was not): a flag of its own,
 /// so that asking costs the probe no second lock a step (the locks were 5 % of a sweep's step).
 pub(super) struct S2Memo<'a>(Mutex<Kept<'a>>, AtomicBool);
 
 impl Default for S2Memo<'_> {
     fn default() -> Self {
-        Self(Mutex::new(Kept { entry: None }), AtomicBool::new(true))
+        Self(
+            Mutex::new(Kept {
+                entries: Vec::new(),
+                clock: 0,
+                hits: 0,
+            }),
+            AtomicBool::new(true),
+        )
     }
 }
 
@@ -115,8 +138,8 @@ impl std::fmt::Debug for S2Memo<'_> {
 
 impl<'a> VesselSystem<'a> {
     /// Call `f` with the frozen view of a sub-step that starts at `s` and flow S2 assembled
-    /// there (with `ledger`, each account's rows too), reusing the last assembly when it was
-    /// made from the same bits; `by_probe`: the call is the probe's.
+    /// there (with `ledger`, each account's rows too), reusing a kept assembly made from the
+    /// same bits; `by_probe`: the call is the probe's.
     pub(super) fn with_s2<R>(
         &self,
         s: &VesselState,
@@ -131,42 +154,52 @@ impl<'a> VesselSystem<'a> {
             return f(&fr, &self.s2_of(&fr, ledger));
         };
         let kept = &mut *guard;
-        let entry = match &mut kept.entry {
-            Some(e)
-                if e.key.matches(s, on, self.assembly_reads_motion)
-                    && (e.b.booked.is_some() || !ledger) =>
-            {
-                if e.by_probe && !by_probe {
-                    e.reused = true;
-                    self.s2_memo.1.store(true, Relaxed);
-                }
-                e.fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
-                e.fr.actuators = s.act;
-                e.fr.held = self.held_of(s);
-                e
+        kept.clock += 1;
+        let clock = kept.clock;
+        let hit = kept.entries.iter().position(|e| {
+            e.key.matches(s, on, self.assembly_reads_motion) && (e.b.booked.is_some() || !ledger)
+        });
+        let entry = if let Some(i) = hit {
+            let e = &mut kept.entries[i];
+            if e.by_probe && !by_probe {
+                e.reused = true;
+                self.s2_memo.1.store(true, Relaxed);
             }
-            Some(e) => {
-                if e.by_probe && !e.reused {
-                    self.s2_memo.1.store(false, Relaxed);
-                }
-                e.key = Key::of(s, on);
-                e.fr = self.frozen(s, on);
-                e.by_probe = by_probe;
-                e.reused = false;
-                self.s2_into(&e.fr, ledger, &mut e.b);
-                e
+            e.fr.velocity = self.vessel.body.velocity(&s.p, &s.m);
+            e.fr.actuators = s.act;
+            e.fr.held = self.held_of(s);
+            e.served = clock;
+            kept.hits += 1;
+            &mut kept.entries[i]
+        } else if kept.entries.len() < KEPT {
+            let fr = self.frozen(s, on);
+            let b = self.s2_of(&fr, ledger);
+            kept.entries.push(Entry {
+                key: Key::of(s, on),
+                fr,
+                b,
+                by_probe,
+                reused: false,
+                served: clock,
+            });
+            kept.entries.last_mut().expect("just pushed")
+        } else {
+            // The least recently served is rebuilt in place (its allocation kept).
+            let e = kept
+                .entries
+                .iter_mut()
+                .min_by_key(|e| e.served)
+                .expect("KEPT entries");
+            if e.by_probe && !e.reused {
+                self.s2_memo.1.store(false, Relaxed);
             }
-            None => {
-                let fr = self.frozen(s, on);
-                let b = self.s2_of(&fr, ledger);
-                kept.entry.insert(Entry {
-                    key: Key::of(s, on),
-                    fr,
-                    b,
-                    by_probe,
-                    reused: false,
-                })
-            }
+            e.key = Key::of(s, on);
+            e.fr = self.frozen(s, on);
+            e.by_probe = by_probe;
+            e.reused = false;
+            e.served = clock;
+            self.s2_into(&e.fr, ledger, &mut e.b);
+            e
         };
         serve(entry, ledger, f)
     }
@@ -258,6 +291,43 @@ mod tests {
                 assert_eq!(b.sys, fresh.sys);
                 assert_ne!(b.sys, before);
             });
+        }
+    }
+
+    /// An adaptive run takes kept assemblies (the whole step's and its first half's common
+    /// start, an output's start), at least one per step tried, and gives the same bits as a run
+    /// that assembles every sub-step afresh (its memo held by someone else).
+    #[test]
+    fn adaptive_steps_take_kept_assemblies_and_the_same_bits() {
+        use crate::methods::{Method, Outer};
+        use crate::solve::{run, Options, Tolerance};
+        let v = Vessel::paper();
+        let method: Method = "sp2".parse().unwrap();
+        let opts = Options {
+            outer: Outer::Dissipative,
+            tolerance: Some(Tolerance {
+                rtol: 1e-3,
+                atol: 1e-3,
+                h_max: 300.0,
+                t1: 300.0,
+                save_at: (1..30).map(|k| 10.0 * k as f64).collect(),
+            }),
+            ledger: true,
+            ..Options::steps(0.0, 1.0, 300, 1)
+        };
+        let sys = VesselSystem::new(&v, Some(0.0));
+        let kept = run(&sys, &method, v.initial_state(), &opts).unwrap();
+        let hits = sys.s2_memo.0.lock().unwrap().hits as usize;
+        assert!(hits >= kept.steps + kept.rejected, "{hits} {}", kept.steps);
+        let fresh = VesselSystem::new(&v, Some(0.0));
+        let held = fresh.s2_memo.0.lock().unwrap();
+        let again = run(&fresh, &method, v.initial_state(), &opts).unwrap();
+        drop(held);
+        assert_eq!(fresh.s2_memo.0.lock().unwrap().hits, 0);
+        assert_eq!(kept.t, again.t);
+        assert_eq!(kept.energy, again.energy);
+        for (a, b) in kept.states.iter().zip(&again.states) {
+            assert_eq!((a.p, a.m, a.q, a.x, a.mu), (b.p, b.m, b.q, b.x, b.mu));
         }
     }
 
