@@ -168,6 +168,16 @@ def test_the_compiled_dop853_peer_matches_the_independent_model():
         f.solve_dop853((0.0, 1.0), bad, 1e-6, np.array([1e-9]))
 
 
+def test_no_compiled_field_for_a_vessel_whose_components_keep_states():
+    """The compiled field is the 27 states' (eq. 39): for a vessel with a dynamic pipe (states of
+    its own) it is refused by name when made, not failed inside when called."""
+    from phsplit import _core
+
+    v = phsplit.scenario.load(phsplit.scenario.resolve("pipelay-dynamic")).vessel
+    with pytest.raises(phsplit.InvalidInputError, match="pipe.*states of its own"):
+        _core.VectorField(v._inner, 0.0)
+
+
 def test_chunked_cli_output_equals_one_simulate_call(tmp_path):
     assert main(["simulate", "--out", str(tmp_path), "--no-plot", "--save-every", "3"]) == 0
     s = phsplit.simulate(phsplit.Vessel.paper(), save_every=3, linear_flow="exact")  # the Fig. 2 scenario's

@@ -292,11 +292,19 @@ struct PyVectorField {
 impl PyVectorField {
     #[new]
     #[pyo3(signature = (vessel, control_start=None))]
-    fn new(vessel: &PyVessel, control_start: Option<f64>) -> Self {
-        Self {
+    fn new(vessel: &PyVessel, control_start: Option<f64>) -> PyResult<Self> {
+        // The field is the 27 states' (eq. 39): a vessel whose components keep states of their
+        // own, or a memory from step to step, has none that a solver of it could integrate.
+        use phsplit_core::solve::Model;
+        if let Some(why) = VesselSystem::new(&vessel.inner, control_start).runge_kutta_refused() {
+            return Err(InvalidInputError::new_err(format!(
+                "no vector field f(t, y) of {STATE_DIM} states for external solvers for this vessel: {why}"
+            )));
+        }
+        Ok(Self {
             vessel: vessel.inner.clone(),
             control_start,
-        }
+        })
     }
     /// `y' = f(t, y)` as a new array.
     fn __call__<'py>(
