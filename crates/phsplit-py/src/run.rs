@@ -114,19 +114,20 @@ fn integrate<'py>(
                     .with_extrema(extrema);
                 let traj = run_watched(&sys, &s2.method, y0, &opts, mon)?;
                 let s2_solver = sys.s2_solver();
-                // The force and moment of each account at the saved states.
-                let wrenches: Vec<_> = traj
+                // The force and moment of each account, and the components' outputs, at the
+                // saved states: both of one state in turn, so that what a thread keeps of the
+                // sea at that time (docs/explanation/fast-sea.md) serves both.
+                let (wrenches, outputs): (Vec<_>, Vec<_>) = traj
                     .t
                     .iter()
                     .zip(&traj.states)
-                    .map(|(t, s)| sys.account_wrenches(s, *t, sys.control_on(*t)))
-                    .collect();
-                let outputs: Vec<_> = traj
-                    .t
-                    .iter()
-                    .zip(&traj.states)
-                    .map(|(t, s)| sys.outputs(s, *t))
-                    .collect();
+                    .map(|(t, s)| {
+                        (
+                            sys.account_wrenches(s, *t, sys.control_on(*t)),
+                            sys.outputs(s, *t),
+                        )
+                    })
+                    .unzip();
                 Ok::<_, Error>((traj, wrenches, outputs, s2_solver))
             }))
         })

@@ -260,7 +260,7 @@ impl Force for Wind {
             "wind_speed",
             "m s-1",
             "wind speed (mean and gusts)",
-            self.speed_at(t),
+            self.speed_fast(t),
         ));
     }
 }
