@@ -53,6 +53,7 @@ pub fn run_splitting_adaptive<M: SplitModel>(
     opts.validate()?;
     tol.validate(opts.t0)?;
     model.supports_order(method.order)?;
+    model.revisits_states(true);
     let subs = super::kernel::flows_of(method, opts);
     let p = method.order as i32;
     let k = f64::from(p + 1);

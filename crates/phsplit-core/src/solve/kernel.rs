@@ -39,6 +39,7 @@ pub fn run_splitting_watched<M: SplitModel>(
 ) -> Result<Trajectory<M::State>> {
     opts.validate()?;
     model.supports_order(method.order)?;
+    model.revisits_states(false);
     let subs = flows_of(method, opts);
     let fsal = subs.len() > 1 && subs[0].0 == subs[subs.len() - 1].0;
     let last = subs.len() - 1;

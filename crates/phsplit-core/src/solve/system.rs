@@ -274,6 +274,12 @@ pub trait SplitModel: Model {
     /// Check that the model can provide sub-flows of order `order` (paper Remark 2.3); the
     /// kernel asks this once, before the first step.
     fn supports_order(&self, order: usize) -> crate::Result<()>;
+
+    /// Told once, before the first step, whether the run will ask for sub-steps from states it
+    /// has asked for before (adaptive steps: the whole step after its halves, an output's
+    /// branch from a step's start). A model that keeps what it computed at a state may keep
+    /// more for such a run; what it computes must not change. Nothing by default.
+    fn revisits_states(&self, _revisits: bool) {}
     /// Advance `s` by flow `which` over `h` (of either sign) on a step that starts at `t_step`
     /// (which decides switches, like the controller's start); the sub-step itself starts at
     /// time `t` (the flow's own clock: a time-dependent flow is evaluated from `t` to `t + h`).

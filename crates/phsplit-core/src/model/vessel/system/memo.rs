@@ -32,7 +32,7 @@
 use super::super::forces::{Frozen, S2Builder};
 use super::super::state::{Actuators, VesselState};
 use super::VesselSystem;
-use std::sync::atomic::{AtomicBool, Ordering::Relaxed};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering::Relaxed};
 use std::sync::Mutex;
 
 /// What an assembly depends on, bit for bit: `Q`, the controller's state, and the momenta `p`,
@@ -92,10 +92,12 @@ struct Entry<'a> {
     served: u64,
 }
 
-/// How many assemblies are kept. An adaptive step assembles S2 at its start twice (the whole
-/// step and its first half, `solve/adaptive.rs`), and an output inside the step starts from the
-/// step's start or the end of its first half: four keep each of those until it is asked again.
-const KEPT: usize = 4;
+/// How many assemblies are kept for a run that comes back to states (adaptive steps,
+/// [`crate::solve::SplitModel::revisits_states`]; other runs keep one). An adaptive step
+/// assembles S2 at its start twice (the whole step and its first half, `solve/adaptive.rs`),
+/// and an output inside the step starts from the step's start or the end of its first half:
+/// four keep each of those until it is asked again.
+pub(super) const KEPT: usize = 4;
 
 struct Kept<'a> {
     entries: Vec<Entry<'a>>,
@@ -108,7 +110,8 @@ struct Kept<'a> {
 /// them for one of them; the others assemble as if there were none. Beside them, whether the
 /// probe's whole assembly is taken by the next sub-step (until one was not): a flag of its own,
 /// so that asking costs the probe no second lock a step (the locks were 5 % of a sweep's step).
-pub(super) struct S2Memo<'a>(Mutex<Kept<'a>>, AtomicBool);
+/// Beside them too, how many it keeps ([`KEPT`] or one).
+pub(super) struct S2Memo<'a>(Mutex<Kept<'a>>, AtomicBool, AtomicUsize);
 
 impl Default for S2Memo<'_> {
     fn default() -> Self {
@@ -119,6 +122,7 @@ impl Default for S2Memo<'_> {
                 hits: 0,
             }),
             AtomicBool::new(true),
+            AtomicUsize::new(1),
         )
     }
 }
@@ -171,7 +175,7 @@ impl<'a> VesselSystem<'a> {
             e.served = clock;
             kept.hits += 1;
             &mut kept.entries[i]
-        } else if kept.entries.len() < KEPT {
+        } else if kept.entries.len() < self.s2_memo.2.load(Relaxed) {
             let fr = self.frozen(s, on);
             let b = self.s2_of(&fr, ledger);
             kept.entries.push(Entry {
@@ -189,7 +193,7 @@ impl<'a> VesselSystem<'a> {
                 .entries
                 .iter_mut()
                 .min_by_key(|e| e.served)
-                .expect("KEPT entries");
+                .expect("at least one kept");
             if e.by_probe && !e.reused {
                 self.s2_memo.1.store(false, Relaxed);
             }
@@ -202,6 +206,19 @@ impl<'a> VesselSystem<'a> {
             e
         };
         serve(entry, ledger, f)
+    }
+
+    /// Keep up to `n` assemblies (at least one) from now on; the least recently served go
+    /// beyond that.
+    pub(super) fn keep_assemblies(&self, n: usize) {
+        let n = n.max(1);
+        self.s2_memo.2.store(n, Relaxed);
+        if let Ok(mut kept) = self.s2_memo.0.try_lock() {
+            if kept.entries.len() > n {
+                kept.entries.sort_by_key(|e| std::cmp::Reverse(e.served));
+                kept.entries.truncate(n);
+            }
+        }
     }
 
     /// Whether the probe should assemble S2 whole (its assembly is taken by the next sub-step)
@@ -319,6 +336,14 @@ mod tests {
         let kept = run(&sys, &method, v.initial_state(), &opts).unwrap();
         let hits = sys.s2_memo.0.lock().unwrap().hits as usize;
         assert!(hits >= kept.steps + kept.rejected, "{hits} {}", kept.steps);
+        assert_eq!(sys.s2_memo.0.lock().unwrap().entries.len(), KEPT);
+        // Fixed steps on the same system keep the last assembly only.
+        let fixed = Options {
+            tolerance: None,
+            ..Options::steps(0.0, 1.0, 20, 5)
+        };
+        run(&sys, &method, v.initial_state(), &fixed).unwrap();
+        assert_eq!(sys.s2_memo.0.lock().unwrap().entries.len(), 1);
         let fresh = VesselSystem::new(&v, Some(0.0));
         let held = fresh.s2_memo.0.lock().unwrap();
         let again = run(&fresh, &method, v.initial_state(), &opts).unwrap();

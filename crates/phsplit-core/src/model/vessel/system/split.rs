@@ -25,6 +25,12 @@ impl SplitModel for VesselSystem<'_> {
             }
         }
     }
+    fn revisits_states(&self, revisits: bool) {
+        // Adaptive steps come back to a step's start and midpoint: keep the assemblies made
+        // there (`memo.rs`); fixed steps keep the last only (more would only spread the
+        // memory a step touches).
+        self.keep_assemblies(if revisits { super::memo::KEPT } else { 1 });
+    }
     fn supports_order(&self, order: usize) -> Result<()> {
         if order > 2 && !self.own_flowing.is_empty() {
             return Err(Error::InvalidInput(format!(
