@@ -45,32 +45,36 @@ impl VesselSystem<'_> {
         t: f64,
         on: bool,
     ) -> Vec<(Vector3<f64>, Vector3<f64>)> {
-        let fr = self.frozen(s, on);
-        let b = self.s2_of(&fr, true);
-        let booked = b.booked.as_deref().expect("built with the ledger");
-        let z = self.blocks_of(s);
-        let nu = self.vessel.body.velocity(&s.p, &s.m);
-        let g = self.forcing(&fr, t, &z, &s.own);
-        let mut f: Vec<[Vector3<f64>; 2]> = (0..self.accounts.len())
-            .map(|k| {
-                [
-                    booked[k][0].at(&nu, &z[0]) + g.booked(k)[0],
-                    booked[k][1].at(&nu, &z[1]) + g.booked(k)[1],
-                ]
-            })
-            .collect();
-        b.add_cross_booked(&z, &mut f);
-        // A subsystem's force on the hull (its account books what it dissipates).
-        let mut rates = vec![0.0; s.own.len()];
-        let own = self.own_wrenches(&fr, &z, &s.own);
-        for (acc, w) in own
-            .into_iter()
-            .chain(self.own_flow_field(&fr, s, &mut rates))
-        {
-            f[acc][0] += w[0];
-            f[acc][1] += w[1];
-        }
-        f.into_iter().map(|[f, m]| (f, m)).collect()
+        // The assembly with each account's rows, kept as a sub-step's is (`memo.rs`: the same
+        // bits as a fresh one, without a new allocation for each state reported).
+        self.with_s2(s, on, true, false, |fr, b| {
+            let booked = b.booked.as_deref().expect("built with the ledger");
+            let z = self.blocks_of(s);
+            let nu = self.vessel.body.velocity(&s.p, &s.m);
+            let g = self.forcing(fr, t, &z, &s.own);
+            let mut f: Vec<[Vector3<f64>; 2]> = (0..self.accounts.len())
+                .map(|k| {
+                    [
+                        booked[k][0].at(&nu, &z[0]) + g.booked(k)[0],
+                        booked[k][1].at(&nu, &z[1]) + g.booked(k)[1],
+                    ]
+                })
+                .collect();
+            b.add_cross_booked(&z, &mut f);
+            // A subsystem's force on the hull (its account books what it dissipates).
+            if self.own_dim > 0 {
+                let mut rates = vec![0.0; s.own.len()];
+                let own = self.own_wrenches(fr, &z, &s.own);
+                for (acc, w) in own
+                    .into_iter()
+                    .chain(self.own_flow_field(fr, s, &mut rates))
+                {
+                    f[acc][0] += w[0];
+                    f[acc][1] += w[1];
+                }
+            }
+            f.into_iter().map(|[f, m]| (f, m)).collect()
+        })
     }
 
     /// The controller's force and moment (body frame, about the body origin) at `s` on a step
