@@ -14,9 +14,40 @@
 //! and `z(t) = exp(Ā (t − t_k)) z_k`. The states at the rows are computed once; a value at
 //! any time is one 5×5 exponential away (no step size, no error beyond round-off). The
 //! filter starts at rest on the first row's set point.
+//!
+//! A collocation asks for the same stage times at every pass of its fixed point: each thread
+//! keeps the last few values it computed (by the model's identity and the time's bits), so a
+//! time asked again costs no exponential, and every value is the same bits however often, in
+//! whatever order and on whichever thread it is asked.
 
 use crate::error::{Error, Result};
 use nalgebra::{SMatrix, SVector};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// An identity for the per-thread memo: unique per model built (copies share it, with the same
+/// table). Equal for any two, so that it does not change which models compare equal.
+#[derive(Debug, Clone, Copy)]
+struct Key(u64);
+
+impl PartialEq for Key {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+static NEXT: AtomicU64 = AtomicU64::new(1);
+
+/// How many values a thread keeps: the stages of a three-stage collocation taken in turn, and
+/// one more.
+const KEPT: usize = 4;
+
+thread_local! {
+    /// The last values computed on this thread: (model, time's bits, value), newest first.
+    static LAST: Cell<[(u64, u64, Desired); KEPT]> = const {
+        Cell::new([(0, 0, Desired::ZERO); KEPT])
+    };
+}
 
 /// How the set point moves between two rows of the table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,7 +61,8 @@ pub enum Interpolation {
 /// The number of filtered channels: position `x, y, z` and the Euler angles.
 pub const CHANNELS: usize = 6;
 
-/// The reference model with its set-point table.
+/// The reference model with its set-point table. Built by [`Reference::new`] and read, never
+/// changed: the states at the rows and the identity of the per-thread memo are the table's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Reference {
     /// Natural frequency `ω` (rad/s) and relative damping `ζ`.
@@ -43,6 +75,7 @@ pub struct Reference {
     pub interpolation: Interpolation,
     /// The filter's augmented state at each row, per channel.
     knots: Vec<[SVector<f64, 5>; CHANNELS]>,
+    key: Key,
 }
 
 /// The desired value, rate and acceleration of every channel at one time.
@@ -51,6 +84,14 @@ pub struct Desired {
     pub value: [f64; CHANNELS],
     pub rate: [f64; CHANNELS],
     pub acceleration: [f64; CHANNELS],
+}
+
+impl Desired {
+    const ZERO: Desired = Desired {
+        value: [0.0; CHANNELS],
+        rate: [0.0; CHANNELS],
+        acceleration: [0.0; CHANNELS],
+    };
 }
 
 impl Reference {
@@ -107,6 +148,7 @@ impl Reference {
             values,
             interpolation,
             knots: Vec::new(),
+            key: Key(NEXT.fetch_add(1, Ordering::Relaxed)),
         };
         let mut z: [SVector<f64, 5>; CHANNELS] = std::array::from_fn(|c| {
             SVector::<f64, 5>::from([r.values[0][c], 0.0, 0.0, r.values[0][c], r.slope(0, c)])
@@ -181,6 +223,20 @@ impl Reference {
 
     /// The desired value, rate and acceleration at `t` (before the first row: at rest on it).
     pub fn at(&self, t: f64) -> Desired {
+        let mut last = LAST.with(|c| c.get());
+        let (key, bits) = (self.key.0, t.to_bits());
+        if let Some(&(_, _, d)) = last.iter().find(|(k, b, _)| *k == key && *b == bits) {
+            return d;
+        }
+        let d = self.compute(t);
+        last.rotate_right(1);
+        last[0] = (key, bits, d);
+        LAST.with(|c| c.set(last));
+        d
+    }
+
+    /// [`Self::at`], computed.
+    fn compute(&self, t: f64) -> Desired {
         let k = self.segment(t);
         let tau = t - self.times[k];
         let mut d = Desired {
@@ -238,5 +294,39 @@ mod tests {
             assert!((d.rate[2] - rate).abs() < 1e-12);
         }
         assert_eq!(r.at(5.0).value[0], 0.0);
+    }
+
+    /// A value asked again, after others (more than a thread keeps) and on another thread, is
+    /// the same bits as computed.
+    #[test]
+    fn values_asked_again_are_the_computed_ones() {
+        let r = Reference::new(
+            0.05,
+            0.8,
+            vec![0.0, 600.0, 4000.0],
+            vec![one(0.0), one(1.0), one(30.0)],
+            Interpolation::Linear,
+        )
+        .unwrap();
+        let times: Vec<f64> = (0..9).map(|i| 100.0 + 517.3 * i as f64).collect();
+        let first: Vec<Desired> = times.iter().map(|&t| r.at(t)).collect();
+        for (i, &t) in times.iter().enumerate().rev() {
+            assert_eq!(r.at(t), r.compute(t));
+            assert_eq!(r.at(t), first[i]);
+            let (r2, t2) = (r.clone(), t);
+            let there = std::thread::spawn(move || r2.at(t2)).join().unwrap();
+            assert_eq!(there, first[i]);
+        }
+        // Another model at the same times is not served this one's values.
+        let other = Reference::new(
+            0.05,
+            0.8,
+            vec![0.0, 600.0, 4000.0],
+            vec![one(0.0), one(2.0), one(30.0)],
+            Interpolation::Linear,
+        )
+        .unwrap();
+        assert_ne!(other.at(times[1]).value, r.at(times[1]).value);
+        assert_eq!(other.at(times[1]), other.compute(times[1]));
     }
 }
