@@ -2,6 +2,7 @@
 //! the solver's traits ([`crate::solve::system`]); the solver never imports a model.
 pub mod catenary;
 pub mod grid;
+pub mod kept;
 pub mod phasors;
 pub mod reference;
 pub mod vessel;

@@ -29,8 +29,8 @@
 //! direct phase, `≈ ε |ω t|`. The memo makes the results bitwise independent of the order of
 //! evaluation, of threads and of where a run is cut into pieces.
 
+use super::kept::Identity;
 use std::cell::RefCell;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Rows of the table per lattice interval.
 const ROWS: usize = 64;
@@ -38,20 +38,6 @@ const ROWS: usize = 64;
 const REDUCED: f64 = 0.25;
 /// Anchors, and remainders, a thread keeps (a few seas evaluated in turn, each at a few times).
 const MEMO: usize = 8;
-
-/// An identity for the per-thread memo of anchors: unique per set of components (copies share
-/// it, with the same components). Equal for any two, so that it does not change what
-/// components compare equal.
-#[derive(Debug, Clone, Copy)]
-struct Key(u64);
-
-impl PartialEq for Key {
-    fn eq(&self, _: &Self) -> bool {
-        true
-    }
-}
-
-static NEXT: AtomicU64 = AtomicU64::new(1);
 
 /// Regular components' frequencies and phases, with the lattice and table of their fast time
 /// factors.
@@ -66,7 +52,7 @@ pub struct Phasors {
     /// `e^{i ω_k m δ}`, row `m` at `[m K .. (m + 1) K]`.
     row_re: Vec<f64>,
     row_im: Vec<f64>,
-    key: Key,
+    key: Identity,
 }
 
 /// Factors of one set of components kept by a thread: an anchor `e^{i(ω_k jΔ + φ_k)}` (`at` = `j`)
@@ -137,13 +123,13 @@ impl Phasors {
             span: delta * ROWS as f64,
             row_re,
             row_im,
-            key: Key(NEXT.fetch_add(1, Ordering::Relaxed)),
+            key: Identity::new(),
         }
     }
 
     /// The identity the per-thread memos key on (equal for copies).
-    pub fn key(&self) -> u64 {
-        self.key.0
+    pub fn identity(&self) -> Identity {
+        self.key
     }
 
     pub fn len(&self) -> usize {
@@ -182,14 +168,14 @@ impl Phasors {
                 im,
             } = &mut *memo;
             let tj = jf * self.span;
-            let a = kept(anchors, next, self.key.0, j as u64, k, |i| {
+            let a = kept(anchors, next, self.key.get(), j as u64, k, |i| {
                 let (s, c) = (self.omega[i] * tj + self.phase[i]).sin_cos();
                 (c, s)
             });
             // The remainder factors depend on `r` alone: a step size commensurate with `δ`
             // (h = 0.5 s, 0.25 s, 1 s, … and the midpoint rule's nodes) meets a few offsets
             // again and again, which are kept as computed.
-            let q = kept(rems, next_rem, self.key.0, r.to_bits(), k, |i| {
+            let q = kept(rems, next_rem, self.key.get(), r.to_bits(), k, |i| {
                 taylor(self.omega[i] * r)
             });
             re.resize(k, 0.0);

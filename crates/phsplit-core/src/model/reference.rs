@@ -20,33 +20,17 @@
 //! time asked again costs no exponential, and every value is the same bits however often, in
 //! whatever order and on whichever thread it is asked.
 
+use super::kept::{self, Identity, Recent};
 use crate::error::{Error, Result};
 use nalgebra::{SMatrix, SVector};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicU64, Ordering};
-
-/// An identity for the per-thread memo: unique per model built (copies share it, with the same
-/// table). Equal for any two, so that it does not change which models compare equal.
-#[derive(Debug, Clone, Copy)]
-struct Key(u64);
-
-impl PartialEq for Key {
-    fn eq(&self, _: &Self) -> bool {
-        true
-    }
-}
-
-static NEXT: AtomicU64 = AtomicU64::new(1);
 
 /// How many values a thread keeps: the stages of a three-stage collocation taken in turn, and
 /// one more.
 const KEPT: usize = 4;
 
 thread_local! {
-    /// The last values computed on this thread: (model, time's bits, value), newest first.
-    static LAST: Cell<[(u64, u64, Desired); KEPT]> = const {
-        Cell::new([(0, 0, Desired::ZERO); KEPT])
-    };
+    /// The last values computed on this thread ([`kept::at_time`]).
+    static LAST: Recent<Desired, KEPT> = const { Recent::new([(0, 0, Desired::ZERO); KEPT]) };
 }
 
 /// How the set point moves between two rows of the table.
@@ -75,7 +59,7 @@ pub struct Reference {
     pub interpolation: Interpolation,
     /// The filter's augmented state at each row, per channel.
     knots: Vec<[SVector<f64, 5>; CHANNELS]>,
-    key: Key,
+    key: Identity,
 }
 
 /// The desired value, rate and acceleration of every channel at one time.
@@ -148,7 +132,7 @@ impl Reference {
             values,
             interpolation,
             knots: Vec::new(),
-            key: Key(NEXT.fetch_add(1, Ordering::Relaxed)),
+            key: Identity::new(),
         };
         let mut z: [SVector<f64, 5>; CHANNELS] = std::array::from_fn(|c| {
             SVector::<f64, 5>::from([r.values[0][c], 0.0, 0.0, r.values[0][c], r.slope(0, c)])
@@ -223,16 +207,7 @@ impl Reference {
 
     /// The desired value, rate and acceleration at `t` (before the first row: at rest on it).
     pub fn at(&self, t: f64) -> Desired {
-        let mut last = LAST.with(|c| c.get());
-        let (key, bits) = (self.key.0, t.to_bits());
-        if let Some(&(_, _, d)) = last.iter().find(|(k, b, _)| *k == key && *b == bits) {
-            return d;
-        }
-        let d = self.compute(t);
-        last.rotate_right(1);
-        last[0] = (key, bits, d);
-        LAST.with(|c| c.set(last));
-        d
+        kept::at_time(&LAST, self.key, t, || self.compute(t))
     }
 
     /// [`Self::at`], computed.
@@ -300,14 +275,17 @@ mod tests {
     /// the same bits as computed.
     #[test]
     fn values_asked_again_are_the_computed_ones() {
-        let r = Reference::new(
-            0.05,
-            0.8,
-            vec![0.0, 600.0, 4000.0],
-            vec![one(0.0), one(1.0), one(30.0)],
-            Interpolation::Linear,
-        )
-        .unwrap();
+        let route = |middle: f64| {
+            Reference::new(
+                0.05,
+                0.8,
+                vec![0.0, 600.0, 4000.0],
+                vec![one(0.0), one(middle), one(30.0)],
+                Interpolation::Linear,
+            )
+            .unwrap()
+        };
+        let r = route(1.0);
         let times: Vec<f64> = (0..9).map(|i| 100.0 + 517.3 * i as f64).collect();
         let first: Vec<Desired> = times.iter().map(|&t| r.at(t)).collect();
         for (i, &t) in times.iter().enumerate().rev() {
@@ -318,14 +296,7 @@ mod tests {
             assert_eq!(there, first[i]);
         }
         // Another model at the same times is not served this one's values.
-        let other = Reference::new(
-            0.05,
-            0.8,
-            vec![0.0, 600.0, 4000.0],
-            vec![one(0.0), one(2.0), one(30.0)],
-            Interpolation::Linear,
-        )
-        .unwrap();
+        let other = route(2.0);
         assert_ne!(other.at(times[1]).value, r.at(times[1]).value);
         assert_eq!(other.at(times[1]), other.compute(times[1]));
     }

@@ -364,7 +364,7 @@ impl Waves {
         AT_POINT.with(|cell| {
             let mut at = cell.borrow_mut();
             let (sea, px, py, sre, sim, cs, sn) = &mut *at;
-            let key = self.time.key();
+            let key = self.time.identity().get();
             if *sea != key || *px != x.to_bits() || *py != y.to_bits() {
                 self.spatial(x, y, sre, sim);
                 (*sea, *px, *py) = (key, x.to_bits(), y.to_bits());

@@ -31,12 +31,12 @@ use super::{Force, Forcing, Frozen, Output, S2Builder, Sys};
 use crate::error::Error;
 use crate::flows::collocation::Z3;
 use crate::model::grid::{check_periodic, periodic_weights};
+use crate::model::kept::{self, Recent};
 use crate::model::phasors::Phasors;
 use crate::model::vessel::params::{Params, Range};
 use crate::model::vessel::state::VesselState;
 use crate::solve::Account;
 use nalgebra::Vector3;
-use std::cell::Cell;
 use std::sync::Arc;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -144,7 +144,7 @@ thread_local! {
     /// by its time factors' identity and `t` by its bits. The collocation asks for the same
     /// stage times at every pass of its fixed point, in turn: one entry per stage of the
     /// three-stage Gauss rule at most, and one for the ledger's.
-    static LAST_SPEED: Cell<[(u64, u64, f64); SPEEDS]> = const { Cell::new([(0, 0, 0.0); SPEEDS]) };
+    static LAST_SPEED: Recent<f64, SPEEDS> = const { Recent::new([(0, 0, 0.0); SPEEDS]) };
 }
 
 const ACCOUNTS: [Account; 1] = [Account::supplied("wind")];
@@ -168,26 +168,16 @@ impl Wind {
         if self.gusts.is_empty() {
             return self.speed;
         }
-        let key = self.time.key();
-        let mut last = LAST_SPEED.with(|c| c.get());
-        if let Some(&(_, _, u)) = last
-            .iter()
-            .find(|(k, tb, _)| *k == key && *tb == t.to_bits())
-        {
-            return u;
-        }
-        let u = self.speed
-            + self.time.with_at(t, |re, _| {
-                self.gusts
-                    .iter()
-                    .zip(re)
-                    .map(|((_, a, _), c)| a * c)
-                    .sum::<f64>()
-            });
-        last.rotate_right(1);
-        last[0] = (key, t.to_bits(), u);
-        LAST_SPEED.with(|c| c.set(last));
-        u
+        kept::at_time(&LAST_SPEED, self.time.identity(), t, || {
+            self.speed
+                + self.time.with_at(t, |re, _| {
+                    self.gusts
+                        .iter()
+                        .zip(re)
+                        .map(|((_, a, _), c)| a * c)
+                        .sum::<f64>()
+                })
+        })
     }
 
     /// The coefficients at the relative angle `gamma` (rad), periodic linear interpolation.
