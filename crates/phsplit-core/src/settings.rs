@@ -422,6 +422,16 @@ mod tests {
         assert_eq!(name, None);
     }
 
+    /// The table of keys names every flow S2 the core parses (it is written out, a constant).
+    #[test]
+    fn the_keys_name_every_linear_flow() {
+        let (_, allowed) = KEYS.iter().find(|(k, _)| *k == "linear_flow").unwrap();
+        for f in LinearFlow::ALL {
+            assert!(allowed.contains(&format!("'{}'", f.name())), "{allowed}");
+        }
+        assert!(allowed.contains("'auto'"));
+    }
+
     #[test]
     fn a_span_that_is_not_whole_steps_ends_with_a_shorter_one() {
         let mut s = Settings {
