@@ -14,17 +14,18 @@ import phsplit
 import reference as ref
 
 
-def fitted_order(vessel, y0, method: str, hs, t_end: float = 2.0, linear_flow: str = "exact"):
+def fitted_order(vessel, y0, method: str, hs, t_end: float = 2.0, linear_flow: str = "exact",
+                 outer: str = "dissipative"):
     """(slope, errors, reference final state) of ``method`` at the steps ``hs``. The runs keep
-    the paper's scheme (exact S2 unless ``linear_flow`` says otherwise, no projection) and no
-    ledger, as the reference has neither."""
+    the paper's scheme (exact S2 unless ``linear_flow`` says otherwise, S2 outermost unless
+    ``outer`` says otherwise, no projection) and no ledger, as the reference has neither."""
     _, y = ref.solve(vessel.to_dict(), y0, t_end, 0.0, rtol=1e-13)
     pe = y[-1][0:3]
     hs = np.asarray(hs, dtype=float)
     errs = []
     for h in hs:
         s = phsplit.simulate(vessel, (0.0, t_end), h, method, control_start=0.0, ledger=False, initial=y0,
-                             project_invariants=False, linear_flow=linear_flow)
+                             project_invariants=False, linear_flow=linear_flow, outer=outer)
         errs.append(np.linalg.norm(s.p[-1] - pe) / np.linalg.norm(pe))
     errs = np.array(errs)
     keep = errs > 1e-13
