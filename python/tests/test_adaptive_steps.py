@@ -38,21 +38,24 @@ def _adaptive(method: str, tol: float, **kw) -> phsplit.Solution:
     return phsplit.simulate(V, (0.0, T_END), 0.5, method, control_start=0.0, rtol=tol, atol=tol, save_at=TS, **kw)
 
 
-@pytest.mark.parametrize("method, p", [("sp2", 2), ("sp4", 4)])
-def test_the_error_falls_with_the_tolerance_against_an_independent_model(exact_positions, method, p):
+@pytest.mark.parametrize("method, p, outer", [("sp2", 2, "dissipative"), ("sp4", 4, "dissipative"),
+                                              ("sp2", 2, "conservative")])
+def test_the_error_falls_with_the_tolerance_against_an_independent_model(exact_positions, method, p, outer):
     """Error-per-step control: the global error ~ tol^(p/(p+1)) (fitted slope), falling and below 20 tol at
-    each tolerance, and the runs land on every output time exactly."""
+    each tolerance (40 tol with S1 outermost, whose splitting error is the larger at the same steps: measured
+    2.6 tol at 1e-2 to 25 tol at 1e-5), and the runs land on every output time exactly."""
     tols = np.array([1e-2, 1e-3, 1e-4, 1e-5])
     errs = []
     for tol in tols:
-        sol = _adaptive(method, tol)
+        sol = _adaptive(method, tol, outer=outer)
         assert sol.status == "completed"
         np.testing.assert_array_equal(sol.t, TS)  # exactly the rows asked for, as with fixed steps
         errs.append(float(np.linalg.norm(sol.x - exact_positions, axis=1).max()))
     errs = np.array(errs)
     slope = np.polyfit(np.log(tols), np.log(errs), 1)[0]
     assert 0.4 < slope < 1.2, (slope, errs)
-    assert np.all(np.diff(errs) < 0) and np.all(errs < 20 * tols), errs
+    bound = 20 if outer == "dissipative" else 40
+    assert np.all(np.diff(errs) < 0) and np.all(errs < bound * tols), errs
 
 
 def test_every_saved_interval_balances_its_ledger_and_dissipates():
@@ -120,11 +123,12 @@ def test_steps_land_on_the_sensors_samples_and_on_a_thruster_loss():
     assert sol.status == "completed" and 123.4 in sol.t
 
 
-def test_save_at_rows_keep_the_ledger_between_them():
+@pytest.mark.parametrize("outer", ["dissipative", "conservative"])
+def test_save_at_rows_keep_the_ledger_between_them(outer):
     """The rows asked for, and the energy booked between consecutive ones summed over the steps
-    between them: ΔH = supplied − dissipated per row to round-off."""
+    between them: ΔH = supplied − dissipated per row to round-off, with either flow outermost."""
     ts = np.arange(60.0, 601.0, 60.0)
-    sol = phsplit.simulate(V, (0.0, 600.0), 0.5, "sp2", control_start=0.0, atol=1e-3, save_at=ts)
+    sol = phsplit.simulate(V, (0.0, 600.0), 0.5, "sp2", control_start=0.0, atol=1e-3, save_at=ts, outer=outer)
     np.testing.assert_array_equal(sol.t, ts)
     assert np.max(sol.ledger.relative_residual()) < 1e-12
     assert sol.ledger.dH[0] == 0.0 and np.all(sol.ledger.by_account["damping"][1:] > 0.0)
