@@ -10,7 +10,8 @@ valgrind's callgrind (deterministic: the difference between runs of ``--steps`` 
     cargo build --release -p phsplit-core --example sea_steps
     .venv/bin/python benchmarks/sea_cost.py [--out benchmarks/results/sea_cost.md]
 
-The sea's run is also measured with S2 by two Gauss stages (``linear_flow = "gauss4"``).
+The sea's run is also measured with S2 by two Gauss stages (``linear_flow = "gauss4"``), and
+both with S1 outermost (``outer = "conservative"``).
 """
 from __future__ import annotations
 
@@ -84,6 +85,11 @@ def main() -> None:
         # what "auto" takes for SP2 at fixed steps in a sea).
         runs = {name: (p, []) for name, p in files.items()}
         runs["weather_gauss4"] = (files["weather"], ["gauss4"])
+        # S1 outermost (outer "conservative"): one S2 a step; the sea with one and three stages
+        # (three: the workloads' fastest setting to 1 cm in dp-weather).
+        runs["calm_s1"] = (files["calm"], ["exact", "conservative"])
+        runs["weather_s1"] = (files["weather"], ["gauss", "conservative"])
+        runs["weather_gauss6_s1"] = (files["weather"], ["gauss6", "conservative"])
         per_step = {}
         for name, (p, flow) in runs.items():
             n1, n2 = args.steps // 2, args.steps
@@ -115,6 +121,15 @@ def main() -> None:
         f"mean wind {', '.join(f'{x:.2f}' for x in times['mean_wind'])}; "
         f"dp-weather {', '.join(f'{x:.2f}' for x in times['weather'])}; "
         f"dp-weather (gauss4) {', '.join(f'{x:.2f}' for x in times['weather_gauss4'])}.\n"
+        "\nThe same steps with S1 outermost (outer = \"conservative\": S1 half steps around one S2 "
+        "over the whole step); flow S2 exact in calm water, one Gauss stage in the sea, and three "
+        "(gauss6, the workloads' fastest setting to 1 cm in dp-weather).\n\n"
+        "| S1 outermost | calm | dp-weather | dp-weather (gauss6) | dp-weather / calm |\n"
+        "|---|---|---|---|---|\n"
+        f"| instructions per step | {per_step['calm_s1']:.0f} | {per_step['weather_s1']:.0f} | "
+        f"{per_step['weather_gauss6_s1']:.0f} | {per_step['weather_s1'] / per_step['calm_s1']:.2f} |\n"
+        f"| wall clock per step (µs) | {med['calm_s1']:.2f} | {med['weather_s1']:.2f} | "
+        f"{med['weather_gauss6_s1']:.2f} | {med['weather_s1'] / med['calm_s1']:.2f} |\n"
     )
     print(text)
     if args.out:

@@ -1,9 +1,10 @@
 //! SP2 steps of a vessel read from a vessel file (the TOML `phsplit.Vessel.to_toml` writes), with
 //! the ledger and the controller on: for comparing a step's cost in a sea with the same step in
 //! calm water (`benchmarks/sea_cost.py` writes both files and counts their instructions). Run:
-//! `cargo run --release -p phsplit-core --example sea_steps -- vessel.toml 0.5 200 [linear_flow]`
-//! (`linear_flow`: the core's default, `"exact"` where it acts and Gauss of the method's order
-//! where S2 has a forcing part, unless named).
+//! `cargo run --release -p phsplit-core --example sea_steps -- vessel.toml 0.5 200 [linear_flow
+//! [outer]]` (`linear_flow`: the core's default, `"exact"` where it acts and Gauss of the
+//! method's order where S2 has a forcing part, unless named; `outer`: `"dissipative"`, S2
+//! outermost, unless `"conservative"`).
 use phsplit_core::methods::{Method, Outer};
 use phsplit_core::model::vessel::{LinearFlow, Vessel, VesselSystem};
 use phsplit_core::solve::{run, Options};
@@ -30,7 +31,10 @@ fn main() {
         n_steps: n,
         last_h: h,
         save_every: n,
-        outer: Outer::Dissipative,
+        outer: args
+            .get(5)
+            .map(|o| o.parse::<Outer>().expect("an outer flow"))
+            .unwrap_or(Outer::Dissipative),
         ledger: true,
         tolerance: None,
     };
