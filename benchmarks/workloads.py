@@ -97,6 +97,11 @@ def atol_of(v: phsplit.Vessel, y0: np.ndarray, tau: float) -> np.ndarray:
     return tau * a
 
 
+def outermost(outer: str) -> str:
+    """What a contender's label says of its outer flow (nothing for the default, S2 outermost)."""
+    return " S1 outermost" if outer == "conservative" else ""
+
+
 def best_of(fn, repeats: int, budget: float):
     """The minimum wall time of at least ``repeats`` calls, more while under ``budget`` s."""
     times, out, spent = [], None, 0.0
@@ -165,7 +170,7 @@ def main() -> int:
             # than two stages in each half.
             settings += [("gauss4", "conservative"), ("gauss6", "conservative")] if m in ("sp2", "mcl2") else []
             for flow, outer in settings:
-                label = f"phsplit {m} {flow}" + (" S1 outermost" if outer == "conservative" else "")
+                label = f"phsplit {m} {flow}" + outermost(outer)
                 for h in hs:
                     sec, sol = best_of(lambda: phsplit.simulate(v, (0.0, T), h, m, control_start=0.0, ledger=False,
                                                                 save_every=int(round(DT / h)), linear_flow=flow,
@@ -183,8 +188,7 @@ def main() -> int:
                                                                 outer=outer),
                                        repeats, budget)
                     assert len(sol.t) == len(TS)
-                    label = (f"phsplit {m} adaptive" + ("" if flow == "auto" else f" {flow}")
-                             + (" S1 outermost" if outer == "conservative" else ""))
+                    label = f"phsplit {m} adaptive" + ("" if flow == "auto" else f" {flow}") + outermost(outer)
                     add(label, f"tol={tau:g}", sec, err(sol.x), f"({sol.steps} steps, {sol.meta['rejected']} rejected)")
         for h in ([2.0, 1.0, 0.5, 0.25] if not heavy else [1.0, 0.5, 0.25]):
             sec, sol = best_of(lambda: phsplit.simulate(v, (0.0, T), h, "rk4", control_start=0.0, ledger=False,
